@@ -1,0 +1,196 @@
+//! Contact laws composed of small parts: a normal force model and a tangential model (spring,
+//! dashpot and Coulomb cap). A variant is a new part, chosen once when the simulation is built,
+//! never an `if` in the pair loop.
+//!
+//! Conventions (MercuryDPM, `BaseInteraction` and `SlidingFrictionInteraction`; see
+//! `benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I the
+//! higher; the unit normal `n` points from I to P; the overlap `δ = r_P + r_I − |x_P − x_I|` is
+//! positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on P
+//! (I receives the opposite).
+
+pub mod normal;
+pub mod tangential;
+
+use crate::Vec3;
+pub use normal::{LinearSpringDashpot, NormalModel};
+pub use tangential::{Frictionless, MercurySlidingFriction, TangentialModel};
+
+/// Kinematics of one pair in contact, evaluated at the contact point.
+#[derive(Clone, Copy, Debug)]
+pub struct PairKinematics {
+    /// Unit normal from I to P.
+    pub n: Vec3,
+    /// Centre distance |x_P − x_I| (length).
+    pub dist: f64,
+    /// Overlap δ > 0 (length).
+    pub delta: f64,
+    /// Lever arm of P: c − x_P (length).
+    pub arm_p: Vec3,
+    /// Lever arm of I: c − x_I (length).
+    pub arm_i: Vec3,
+    /// Relative velocity of P's material point at c with respect to I's (length/time).
+    pub v_rel: Vec3,
+    /// Normal relative velocity v_rel·n (positive when separating).
+    pub vn: f64,
+    /// Tangential relative velocity v_rel − vn·n.
+    pub vt: Vec3,
+    /// Relative velocity of the centres v_P − v_I.
+    pub v_centres: Vec3,
+}
+
+/// Force and torques produced by one contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairForce {
+    /// Total force on P (I receives −f).
+    pub f: Vec3,
+    /// Signed normal force f·n (negative in the attractive tail when not clipped).
+    pub fn_signed: f64,
+    /// Torque on P about its centre.
+    pub torque_p: Vec3,
+    /// Torque on I about its centre.
+    pub torque_i: Vec3,
+}
+
+/// Everything known about the two spheres of a candidate pair.
+#[derive(Clone, Copy, Debug)]
+pub struct PairInput {
+    /// Separation x_P − x_I (minimum image).
+    pub r: Vec3,
+    /// Radii of P and I.
+    pub rad_p: f64,
+    pub rad_i: f64,
+    /// Velocities of P and I (the half-step velocities during a time step).
+    pub v_p: Vec3,
+    pub v_i: Vec3,
+    /// Angular velocities of P and I.
+    pub w_p: Vec3,
+    pub w_i: Vec3,
+}
+
+impl PairInput {
+    /// Contact geometry and kinematics, or `None` when the spheres do not touch
+    /// (contact iff |x_P − x_I| < r_P + r_I, strict, as in MercuryDPM).
+    #[inline(always)]
+    pub fn kinematics(&self) -> Option<PairKinematics> {
+        let sum = self.rad_p + self.rad_i;
+        let d2 = self.r.norm_squared();
+        if d2 >= sum * sum {
+            return None;
+        }
+        let dist = d2.sqrt();
+        let n = self.r / dist;
+        let delta = sum - dist;
+        // Lever arms r − δ/2 (MercuryDPM: contact point in the middle of the overlap).
+        let arm_p = -(self.rad_p - 0.5 * delta) * n;
+        let arm_i = self.r + arm_p;
+        // Velocity of each sphere's material point at c: v + ω × (c − x).
+        let v_rel = (self.v_p + self.w_p.cross(&arm_p)) - (self.v_i + self.w_i.cross(&arm_i));
+        let vn = v_rel.dot(&n);
+        let vt = v_rel - vn * n;
+        Some(PairKinematics {
+            n,
+            dist,
+            delta,
+            arm_p,
+            arm_i,
+            v_rel,
+            vn,
+            vt,
+            v_centres: self.v_p - self.v_i,
+        })
+    }
+}
+
+/// A complete contact law: the force of one contact from its kinematics and its history.
+pub trait ContactLaw: Send + Sync {
+    /// False when the law can never produce a tangential force: the solver then skips torques
+    /// and rotation entirely.
+    const TANGENTIAL: bool;
+
+    /// Force and torques of a contact, updating the tangential history `xi` (the elastic
+    /// tangential displacement, length units) over one time step `dt`.
+    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce;
+}
+
+/// A normal model and a tangential model composed into a contact law.
+#[derive(Clone, Debug)]
+pub struct Composed<N, T> {
+    pub normal: N,
+    pub tangential: T,
+}
+
+impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
+    const TANGENTIAL: bool = T::ACTIVE;
+
+    #[inline(always)]
+    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce {
+        let fn_signed = self.normal.force(k.delta, k.vn);
+        if T::ACTIVE {
+            let ft = self.tangential.force(k, fn_signed, xi, dt);
+            let f = fn_signed * k.n + ft;
+            PairForce {
+                f,
+                fn_signed,
+                // Torque about each centre: (c − x) × F (MercuryDPM BaseInteraction).
+                torque_p: k.arm_p.cross(&f),
+                torque_i: k.arm_i.cross(&(-f)),
+            }
+        } else {
+            PairForce {
+                f: fn_signed * k.n,
+                fn_signed,
+                torque_p: Vec3::zeros(),
+                torque_i: Vec3::zeros(),
+            }
+        }
+    }
+}
+
+/// The benchmark's law: linear spring–dashpot normal force with absolute damping (not clipped)
+/// and MercuryDPM's sliding friction (rate-form spring, Coulomb cap on spring + dashpot).
+pub type MercuryLaw = Composed<LinearSpringDashpot, MercurySlidingFriction>;
+
+/// The frictionless variant: the same normal force, no tangential force, no rotation.
+pub type FrictionlessLaw = Composed<LinearSpringDashpot, Frictionless>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn input(r: Vec3) -> PairInput {
+        PairInput {
+            r,
+            rad_p: 0.5,
+            rad_i: 0.5,
+            v_p: Vec3::zeros(),
+            v_i: Vec3::zeros(),
+            w_p: Vec3::zeros(),
+            w_i: Vec3::zeros(),
+        }
+    }
+
+    #[test]
+    fn touching_exactly_is_not_a_contact() {
+        assert!(input(Vec3::new(1.0, 0.0, 0.0)).kinematics().is_none());
+        assert!(input(Vec3::new(0.999, 0.0, 0.0)).kinematics().is_some());
+    }
+
+    #[test]
+    fn normal_points_from_i_to_p_and_overlap_is_positive() {
+        let k = input(Vec3::new(0.0, 0.0, 0.9)).kinematics().unwrap();
+        assert_eq!(k.n, Vec3::new(0.0, 0.0, 1.0));
+        assert!((k.delta - 0.1).abs() < 1e-15);
+        // contact point in the middle of the overlap: c = x_P − (r_P − δ/2) n
+        assert!((k.arm_p.z + 0.45).abs() < 1e-15);
+        assert!((k.arm_i.z - 0.45).abs() < 1e-15);
+    }
+
+    #[test]
+    fn spin_enters_the_relative_velocity_with_lever_arm_r_minus_half_overlap() {
+        let mut p = input(Vec3::new(0.0, 0.0, 0.9));
+        p.w_p = Vec3::new(0.0, 1.0, 0.0);
+        let k = p.kinematics().unwrap();
+        // ω × (c − x_P) = (0,1,0) × (0,0,−0.45) = (−0.45, 0, 0)
+        assert!((k.vt.x + 0.45).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,52 @@
+//! Normal force models. Sign convention: the returned force is the signed normal force on P
+//! along n (n from I to P); positive is repulsive.
+
+/// A normal force model: signed normal force from the overlap δ > 0 and the normal relative
+/// velocity vn = (v_P − v_I)·n at the contact point (negative while approaching).
+pub trait NormalModel: Send + Sync {
+    fn force(&self, delta: f64, vn: f64) -> f64;
+}
+
+/// Linear spring with an absolute dashpot, fn = kn·δ − γn·vn (force units; γn in mass/time,
+/// not scaled by the effective mass). Source: MercuryDPM `LinearViscoelasticNormalSpecies`.
+/// The attractive tail at the end of a collision is kept (MercuryDPM does not clip); wrap it in
+/// [`Clipped`] to remove it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearSpringDashpot {
+    pub kn: f64,
+    pub gamman: f64,
+}
+
+impl NormalModel for LinearSpringDashpot {
+    #[inline(always)]
+    fn force(&self, delta: f64, vn: f64) -> f64 {
+        self.kn * delta - self.gamman * vn
+    }
+}
+
+/// Wraps a normal model and clips its attractive part: max(fn, 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clipped<N>(pub N);
+
+impl<N: NormalModel> NormalModel for Clipped<N> {
+    #[inline(always)]
+    fn force(&self, delta: f64, vn: f64) -> f64 {
+        self.0.force(delta, vn).max(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dashpot_is_absolute_and_tail_is_kept_unless_clipped() {
+        let m = LinearSpringDashpot {
+            kn: 2e5,
+            gamman: 15.0,
+        };
+        assert_eq!(m.force(1e-3, -1.0), 200.0 + 15.0);
+        assert!(m.force(1e-6, 1.0) < 0.0);
+        assert_eq!(Clipped(m).force(1e-6, 1.0), 0.0);
+    }
+}

@@ -1,0 +1,31 @@
+//! SHA-256 of the full dynamic state, serialised canonically: little-endian f64 of positions,
+//! velocities and angular velocities of every particle in id order, then for every contact with
+//! a tangential history, sorted by index pair, `P I` as little-endian u32 and ξ as f64.
+
+use sha2::{Digest, Sha256};
+
+use crate::sim::Core;
+
+/// Hex SHA-256 of the state.
+pub fn state_hash(core: &Core) -> String {
+    let mut h = Sha256::new();
+    let p = &core.particles;
+    for a in 0..p.len() {
+        for v in [&p.x[a], &p.v[a], &p.w[a]] {
+            for k in 0..3 {
+                h.update(v[k].to_le_bytes());
+            }
+        }
+    }
+    // The pair list is in canonical (P, I) order; only contacts carry history.
+    for k in 0..core.pairs.p.len() {
+        if core.active[k] {
+            h.update(core.pairs.p[k].to_le_bytes());
+            h.update(core.pairs.i[k].to_le_bytes());
+            for c in 0..3 {
+                h.update(core.xi[k][c].to_le_bytes());
+            }
+        }
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}

@@ -1,0 +1,24 @@
+//! verdem: a deterministic discrete-element solver for spheres, built as a verification harness
+//! and a reproducible benchmark suite for the ON-DEM "granular shear flow between bumpy walls" case.
+//!
+//! Data flow of a run: [`case`] (TOML, validated) → [`scene`] (walls and free spheres, generated or
+//! read) → [`sim`] (the time step, top to bottom) → [`io`] (MercuryCG `.data`/`.fstat` saves,
+//! checkpoints) and [`diagnostics`].
+
+pub mod case;
+pub mod checkpoint;
+pub mod contact;
+pub mod diagnostics;
+pub mod domain;
+pub mod engine;
+pub mod hash;
+pub mod io;
+pub mod neighbor;
+pub mod run;
+pub mod scene;
+pub mod sim;
+pub mod state;
+pub mod team;
+
+/// Three-component vector of `f64` used for positions, velocities, forces and torques.
+pub type Vec3 = nalgebra::Vector3<f64>;

@@ -1,0 +1,178 @@
+//! The `verdem` command line.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+
+use verdem::case::Case;
+use verdem::engine::{self, Overrides};
+use verdem::run::{self, RunOptions};
+use verdem::{checkpoint, hash, scene};
+
+#[derive(Parser)]
+#[command(name = "verdem", version, about = "Deterministic DEM solver, verification harness and benchmark suite")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args, Clone)]
+struct Common {
+    /// Case file (TOML).
+    case: PathBuf,
+    /// Initial configuration: official `GranularShearFlow.data` or a MercuryCG `.data` save.
+    #[arg(long)]
+    init: Option<PathBuf>,
+    /// Worker threads of the time step.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Pair-list skin (length).
+    #[arg(long)]
+    skin: Option<f64>,
+    /// Cell edge of the neighbour grid (length; raised to 2 r_max + skin).
+    #[arg(long)]
+    cell: Option<f64>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a case: MercuryCG saves, diagnostics table, final state hash.
+    Run {
+        #[command(flatten)]
+        common: Common,
+        /// The run ends at this step (default: the case's `run.steps`), also after --resume.
+        #[arg(long)]
+        steps: Option<u64>,
+        /// Output folder (default: out/NAME).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// A save every N steps (default: the case's `run.save_every`).
+        #[arg(long)]
+        save_every: Option<u64>,
+        /// Write a checkpoint every N steps (0 = never).
+        #[arg(long, default_value_t = 0)]
+        checkpoint_every: u64,
+        /// Continue from a checkpoint written by --checkpoint-every.
+        #[arg(long)]
+        resume: Option<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Print the SHA-256 of the full state after N steps (no files written).
+    Hash {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long)]
+        steps: u64,
+    },
+}
+
+fn main() {
+    if let Err(e) = real_main() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::sim::Engine>)> {
+    let case = Case::load(&common.case)?;
+    let scene = scene::build(&case, common.init.as_deref())?;
+    let o = Overrides {
+        threads: common.threads,
+        skin: common.skin,
+        cell: common.cell,
+    };
+    let engine = engine::build(&case, scene, &o);
+    Ok((case, engine))
+}
+
+/// Prints the derived contact numbers so a user sees at once whether a contact is resolved.
+fn print_contact_summary(case: &Case) {
+    let m = case.particle_mass();
+    let dt = case.dt();
+    for (label, meff) in [("free-free", 0.5 * m), ("free-wall", m)] {
+        if let (Some(tc), Some(e)) = (case.collision_time(meff), case.restitution(meff)) {
+            println!("{label}: tc = {tc:.6e}, e = {e:.5}, tc/dt = {:.2}", tc / dt);
+        }
+    }
+    println!("dt = {dt:e}");
+}
+
+fn real_main() -> anyhow::Result<()> {
+    match Cli::parse().command {
+        Command::Run {
+            common,
+            steps,
+            out,
+            save_every,
+            checkpoint_every,
+            resume,
+            quiet,
+        } => {
+            let (case, mut engine) = load(&common)?;
+            print_contact_summary(&case);
+            let tag = format!("{}:{}", case.name, engine.core().particles.len());
+            if let Some(ck) = &resume {
+                checkpoint::read(ck, engine.core_mut(), &tag)?;
+                println!("resumed at step {} (t = {})", engine.core().step, engine.core().time);
+            }
+            let opts = RunOptions {
+                end_step: steps.unwrap_or(case.run.steps),
+                save_every: save_every.unwrap_or(case.run.save_every).max(1),
+                checkpoint_every,
+                out_dir: out.unwrap_or_else(|| PathBuf::from("out").join(&case.name)),
+                name: case.name.clone(),
+                tag,
+                progress: !quiet,
+                write_saves: true,
+            };
+            let s = run::run(engine.as_mut(), &opts, resume.is_some())?;
+            let full = 2e8 / s.rate();
+            println!(
+                "done: step {} t = {} saves {} in {}",
+                s.step,
+                s.time,
+                s.saves,
+                opts.out_dir.display()
+            );
+            println!(
+                "rate: {:.0} steps/s on {} thread(s) ({:.1} s); the full 2e8-step benchmark would take {:.2} h at this rate",
+                s.rate(),
+                engine.core().threads,
+                s.seconds,
+                full / 3600.0
+            );
+            let st = &s.stages;
+            let ms = |ns: u64| ns as f64 * 1e-6;
+            println!(
+                "stages (thread 0): neighbour {:.0} ms ({} rebuilds), forces {:.0} ms, gather+integrate {:.0} ms, barrier wait {:.0} ms; {} pairs in the list",
+                ms(st.neighbor),
+                st.rebuilds,
+                ms(st.forces),
+                ms(st.integrate),
+                ms(st.wait),
+                engine.core().pairs.p.len()
+            );
+            println!("state hash: {}", s.hash);
+            let summary = format!(
+                "case = {:?}\nstep = {}\ntime = {}\nhash = {:?}\nthreads = {}\nsteps_per_second = {}\n",
+                case.name,
+                s.step,
+                s.time,
+                s.hash,
+                engine.core().threads,
+                s.rate()
+            );
+            let p = opts.out_dir.join(format!("{}.summary.toml", case.name));
+            verdem::io::atomic::write(&p, summary.as_bytes()).with_context(|| p.display().to_string())?;
+        }
+        Command::Hash { common, steps } => {
+            let (_, mut engine) = load(&common)?;
+            engine.advance(steps);
+            println!("{}", hash::state_hash(engine.core()));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,171 @@
+//! The run loop: advance the simulation between saves and checkpoints, write MercuryCG files and
+//! the diagnostics table, report progress, and summarise the run.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+
+use crate::diagnostics::{Diagnostics, CSV_HEADER};
+use crate::io::{atomic, mercury};
+use crate::sim::{Engine, StageTimes};
+
+/// Options of one run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// The run ends at this step (also after a resume).
+    pub end_step: u64,
+    pub save_every: u64,
+    /// Write a checkpoint every this many steps (0 = never).
+    pub checkpoint_every: u64,
+    pub out_dir: PathBuf,
+    pub name: String,
+    /// Identifies the case in checkpoints.
+    pub tag: String,
+    /// Show a progress bar.
+    pub progress: bool,
+    /// Write `.data`/`.fstat` saves and diagnostics (false for timing runs).
+    pub write_saves: bool,
+}
+
+/// What a finished run reports.
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    pub step: u64,
+    pub time: f64,
+    pub hash: String,
+    /// Steps advanced in this invocation and the wall time they took (seconds), saves included.
+    pub steps_run: u64,
+    pub seconds: f64,
+    pub stages: StageTimes,
+    pub saves: u64,
+}
+
+impl RunSummary {
+    /// Steps per second of this invocation.
+    pub fn rate(&self) -> f64 {
+        self.steps_run as f64 / self.seconds.max(1e-12)
+    }
+}
+
+/// Path of save `k` of kind `ext` (`data` or `fstat`).
+pub fn save_path(dir: &Path, name: &str, ext: &str, k: u64) -> PathBuf {
+    dir.join(format!("{name}.{ext}.{k:04}"))
+}
+
+/// Path of the diagnostics table.
+pub fn diagnostics_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.diagnostics.csv"))
+}
+
+/// Path of the run's checkpoint.
+pub fn checkpoint_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.checkpoint"))
+}
+
+/// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists.
+pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow::Result<RunSummary> {
+    std::fs::create_dir_all(&opts.out_dir)
+        .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
+    let diag = diagnostics_path(&opts.out_dir, &opts.name);
+    if opts.write_saves {
+        prepare_diagnostics(&diag, engine.core().step, resumed)?;
+    }
+    let start_step = engine.core().step;
+    let bar = progress_bar(opts, start_step);
+    let t0 = Instant::now();
+    let mut saves = 0;
+    let mut first = true;
+    loop {
+        let core = engine.core();
+        let step = core.step;
+        if opts.write_saves && step % opts.save_every == 0 && !(first && resumed) {
+            if !core.forces_ready {
+                engine.advance(0);
+            }
+            write_save(engine, opts, &diag)?;
+            saves += 1;
+        }
+        if opts.checkpoint_every > 0 && step % opts.checkpoint_every == 0 && step != start_step {
+            crate::checkpoint::write(
+                &checkpoint_path(&opts.out_dir, &opts.name),
+                engine.core(),
+                &opts.tag,
+            )?;
+        }
+        first = false;
+        if step >= opts.end_step {
+            break;
+        }
+        let mut next = opts.end_step.min(step + 2000);
+        if opts.write_saves {
+            next = next.min((step / opts.save_every + 1) * opts.save_every);
+        }
+        if opts.checkpoint_every > 0 {
+            next = next.min((step / opts.checkpoint_every + 1) * opts.checkpoint_every);
+        }
+        engine.advance(next - step);
+        if let Some(b) = &bar {
+            b.set_position(engine.core().step);
+            b.set_message(format!("t = {:.3}", engine.core().time));
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let core = engine.core();
+    Ok(RunSummary {
+        step: core.step,
+        time: core.time,
+        hash: crate::hash::state_hash(core),
+        steps_run: core.step - start_step,
+        seconds: t0.elapsed().as_secs_f64(),
+        stages: core.times,
+        saves,
+    })
+}
+
+fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
+    let core = engine.core();
+    let k = core.step / opts.save_every;
+    let data = save_path(&opts.out_dir, &opts.name, "data", k);
+    atomic::write(&data, mercury::data_text(core).as_bytes())
+        .with_context(|| format!("{}: cannot write", data.display()))?;
+    let fstat = save_path(&opts.out_dir, &opts.name, "fstat", k);
+    atomic::write(&fstat, mercury::fstat_text(core).as_bytes())
+        .with_context(|| format!("{}: cannot write", fstat.display()))?;
+    atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())
+        .with_context(|| format!("{}: cannot append", diag.display()))
+}
+
+/// A fresh run starts a new table; a resumed one keeps the rows up to its step.
+fn prepare_diagnostics(path: &Path, step: u64, resumed: bool) -> anyhow::Result<()> {
+    let mut text = String::from(CSV_HEADER);
+    if resumed {
+        let old = std::fs::read_to_string(path).unwrap_or_default();
+        for line in old.lines().skip(1) {
+            let row_step: Option<u64> = line.split(',').nth(1).and_then(|s| s.parse().ok());
+            if row_step.is_some_and(|s| s <= step) {
+                text.push_str(line);
+                text.push('\n');
+            }
+        }
+    }
+    atomic::write(path, text.as_bytes()).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+fn progress_bar(opts: &RunOptions, start: u64) -> Option<indicatif::ProgressBar> {
+    if !opts.progress {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(opts.end_step);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps  {per_sec}  {msg}  ETA {eta}",
+        )
+        .expect("valid template"),
+    );
+    bar.set_position(start);
+    bar.reset_eta();
+    Some(bar)
+}

@@ -1,0 +1,347 @@
+//! Scenes: the bumpy-wall shear geometry (generated or read from a file) and explicit sphere
+//! lists.
+
+use std::path::Path;
+
+use anyhow::{bail, Context};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+
+use crate::case::{Case, Scene as SceneSpec};
+use crate::domain::Domain;
+use crate::io::{mercury, official};
+use crate::state::{Motion, Particles};
+use crate::Vec3;
+
+/// The initial state of a run.
+pub struct Scene {
+    pub domain: Domain,
+    pub particles: Particles,
+    /// Start time (that of the `.data` file it was read from, else 0).
+    pub time: f64,
+}
+
+/// The box of a case.
+pub fn domain_of(case: &Case) -> Domain {
+    Domain::new(
+        Vec3::from(case.domain.lo),
+        Vec3::from(case.domain.hi),
+        case.domain.periodic,
+    )
+}
+
+/// Builds the initial scene of a case; `init` overrides the case's `run.init`.
+pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
+    let domain = domain_of(case);
+    let d = case.material.diameter;
+    let rho = case.material.density;
+    let mut particles = Particles::default();
+    let mut time = 0.0;
+    match &case.scene {
+        SceneSpec::BumpyShear {
+            free,
+            wall_rows,
+            wall_per_row,
+            bottom_z,
+            top_z,
+            bottom_vx,
+            top_vx,
+        } => {
+            let walls = [
+                (bumpy_wall(*wall_rows, *wall_per_row, d, *bottom_z), *bottom_vx),
+                (bumpy_wall(*wall_rows, *wall_per_row, d, *top_z), *top_vx),
+            ];
+            let n_wall = 2 * wall_rows * wall_per_row;
+            let wall_of = |a: usize| (a < n_wall).then(|| (a / (wall_rows * wall_per_row)) as u8);
+            let init_path = init
+                .map(Path::to_path_buf)
+                .or_else(|| case.run.init.as_deref().map(|p| case.resolve(p)));
+            if let Some(path) = init_path {
+                let loaded = load_init(&path, &domain)?;
+                if loaded.x.len() != n_wall + free {
+                    bail!(
+                        "{}: has {} particles, the case expects {} wall + {} free",
+                        path.display(),
+                        loaded.x.len(),
+                        n_wall,
+                        free
+                    );
+                }
+                time = loaded.time;
+                for a in 0..loaded.x.len() {
+                    match wall_of(a) {
+                        Some(g) => {
+                            let v = Vec3::new(walls[g as usize].1, 0.0, 0.0);
+                            if let Some(fv) = loaded.v.get(a) {
+                                if (fv - v).amax() > 1e-9 {
+                                    bail!(
+                                        "{}:{}: wall sphere {} moves at {:?}, the case prescribes {:?}",
+                                        path.display(),
+                                        a + 2,
+                                        a + 1,
+                                        fv.as_slice(),
+                                        v.as_slice()
+                                    );
+                                }
+                            }
+                            particles.push(loaded.x[a], v, Vec3::zeros(), loaded.radius[a], rho, Motion::Prescribed(g));
+                        }
+                        None => particles.push(
+                            loaded.x[a],
+                            loaded.v.get(a).copied().unwrap_or_else(Vec3::zeros),
+                            loaded.w.get(a).copied().unwrap_or_else(Vec3::zeros),
+                            loaded.radius[a],
+                            rho,
+                            Motion::Free,
+                        ),
+                    }
+                }
+            } else {
+                for (g, (pos, vx)) in walls.iter().enumerate() {
+                    for x in pos {
+                        particles.push(*x, Vec3::new(*vx, 0.0, 0.0), Vec3::zeros(), 0.5 * d, rho, Motion::Prescribed(g as u8));
+                    }
+                }
+                let wall_x: Vec<Vec3> = walls.iter().flat_map(|w| w.0.iter().copied()).collect();
+                let zr = (bottom_z + 0.5 * d, top_z - 0.5 * d);
+                for x in random_fill(&domain, &wall_x, *free, d, zr, case.run.seed)? {
+                    particles.push(x, Vec3::zeros(), Vec3::zeros(), 0.5 * d, rho, Motion::Free);
+                }
+            }
+        }
+        SceneSpec::Spheres { sphere } => {
+            for (k, s) in sphere.iter().enumerate() {
+                let motion = if s.fixed { Motion::Prescribed(k.min(255) as u8) } else { Motion::Free };
+                particles.push(Vec3::from(s.x), Vec3::from(s.v), Vec3::from(s.w), 0.5 * d, rho, motion);
+            }
+        }
+    }
+    for x in particles.x.iter_mut() {
+        domain.wrap(x);
+    }
+    Ok(Scene {
+        domain,
+        particles,
+        time,
+    })
+}
+
+/// What an initial file provides.
+struct Loaded {
+    time: f64,
+    x: Vec<Vec3>,
+    radius: Vec<f64>,
+    v: Vec<Vec3>,
+    w: Vec<Vec3>,
+}
+
+/// Reads an official initial file or a MercuryCG `.data` file, checking its box.
+fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let file = path.display().to_string();
+    if official::looks_official(&text) {
+        let f = official::read(path, &text)?;
+        mercury::check_box(&file, &f.lo, &f.hi, domain, 1e-6)?;
+        Ok(Loaded {
+            time: 0.0,
+            x: f.x,
+            radius: f.radius,
+            v: Vec::new(),
+            w: Vec::new(),
+        })
+    } else {
+        let f = mercury::read_data(path)?;
+        mercury::check_box(&file, &f.domain_lo, &f.domain_hi, domain, 1e-6)?;
+        Ok(Loaded {
+            time: f.time,
+            x: f.rows.iter().map(|r| r.x).collect(),
+            radius: f.rows.iter().map(|r| r.radius).collect(),
+            v: f.rows.iter().map(|r| r.v).collect(),
+            w: f.rows.iter().map(|r| r.w).collect(),
+        })
+    }
+}
+
+/// Centres of one hexagonal bumpy wall at height `z`, in the order of the official file:
+/// for each of `per_row` columns along x, the `rows` rows along y; row k at y = d/2 + k·√3/2·d,
+/// even rows shifted by d/2 in x.
+pub fn bumpy_wall(rows: usize, per_row: usize, d: f64, z: f64) -> Vec<Vec3> {
+    let dy = 3f64.sqrt() / 2.0 * d;
+    let mut out = Vec::with_capacity(rows * per_row);
+    for i in 0..per_row {
+        for k in 0..rows {
+            let shift = if k % 2 == 0 { 0.5 * d } else { 0.0 };
+            out.push(Vec3::new(i as f64 * d + shift, 0.5 * d + k as f64 * dy, z));
+        }
+    }
+    out
+}
+
+/// `n` non-overlapping spheres of diameter `d`, placed randomly and homogeneously with centres
+/// in `z_range` and not overlapping `fixed`: start from a random subset of a simple cubic lattice
+/// (spacing ≥ d) and randomise it with hard-sphere Monte Carlo moves (random sequential addition
+/// would stall near its saturation volume fraction ≈ 0.38).
+pub fn random_fill(
+    domain: &Domain,
+    fixed: &[Vec3],
+    n: usize,
+    d: f64,
+    z_range: (f64, f64),
+    seed: u64,
+) -> anyhow::Result<Vec<Vec3>> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let l = domain.lengths();
+    let spacing = d * 1.0001;
+    let (z0, z1) = (z_range.0 + 0.5 * spacing, z_range.1 - 0.5 * spacing);
+    let nx = (l.x / spacing).floor() as usize;
+    let ny = (l.y / spacing).floor() as usize;
+    let nz = ((z1 - z0) / spacing).floor() as usize + 1;
+    let mut sites = Vec::with_capacity(nx * ny * nz);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let x = Vec3::new(
+                    domain.lo.x + (i as f64 + 0.5) * l.x / nx as f64,
+                    domain.lo.y + (j as f64 + 0.5) * l.y / ny as f64,
+                    z0 + k as f64 * spacing,
+                );
+                if fixed.iter().all(|f| domain.min_image(x - f).norm() >= spacing) {
+                    sites.push(x);
+                }
+            }
+        }
+    }
+    if sites.len() < n {
+        bail!("cannot fit {n} spheres of diameter {d} between the walls (room for {} on a lattice)", sites.len());
+    }
+    sites.shuffle(&mut rng);
+    sites.truncate(n);
+    let mut grid = HardSphereGrid::new(domain, d, fixed, &sites);
+    let sweeps = 200;
+    let step = 0.3 * d;
+    for _ in 0..sweeps {
+        for a in 0..n {
+            let trial = {
+                let mut t = sites[a]
+                    + Vec3::new(
+                        rng.gen_range(-step..step),
+                        rng.gen_range(-step..step),
+                        rng.gen_range(-step..step),
+                    );
+                domain.wrap(&mut t);
+                t
+            };
+            if trial.z < z_range.0 || trial.z > z_range.1 {
+                continue;
+            }
+            if grid.free_at(domain, &trial, a, d) {
+                grid.relocate(domain, a, &sites[a], &trial);
+                sites[a] = trial;
+            }
+        }
+    }
+    Ok(sites)
+}
+
+/// Cell lists for hard-sphere moves: fixed spheres and movable ones (by index).
+struct HardSphereGrid {
+    n: [usize; 3],
+    edge: Vec3,
+    cells: Vec<Vec<(bool, usize, Vec3)>>,
+}
+
+impl HardSphereGrid {
+    fn new(domain: &Domain, d: f64, fixed: &[Vec3], movable: &[Vec3]) -> Self {
+        let l = domain.lengths();
+        let n = [0, 1, 2].map(|k| ((l[k] / d).floor() as usize).max(1));
+        let edge = Vec3::new(l.x / n[0] as f64, l.y / n[1] as f64, l.z / n[2] as f64);
+        let mut g = HardSphereGrid {
+            n,
+            edge,
+            cells: vec![Vec::new(); n[0] * n[1] * n[2]],
+        };
+        for (a, x) in fixed.iter().enumerate() {
+            let c = g.cell(domain, x);
+            g.cells[c].push((false, a, *x));
+        }
+        for (a, x) in movable.iter().enumerate() {
+            let c = g.cell(domain, x);
+            g.cells[c].push((true, a, *x));
+        }
+        g
+    }
+
+    fn coords(&self, domain: &Domain, x: &Vec3) -> [i64; 3] {
+        [0, 1, 2].map(|k| {
+            let c = ((x[k] - domain.lo[k]) / self.edge[k]).floor() as i64;
+            c.clamp(0, self.n[k] as i64 - 1)
+        })
+    }
+
+    fn cell(&self, domain: &Domain, x: &Vec3) -> usize {
+        let c = self.coords(domain, x);
+        ((c[2] as usize * self.n[1]) + c[1] as usize) * self.n[0] + c[0] as usize
+    }
+
+    /// True when a sphere at `x` overlaps nothing but movable sphere `me`.
+    fn free_at(&self, domain: &Domain, x: &Vec3, me: usize, d: f64) -> bool {
+        let c = self.coords(domain, x);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let mut cc = [0usize; 3];
+                    let mut inside = true;
+                    for (k, o) in [dx, dy, dz].into_iter().enumerate() {
+                        let m = self.n[k] as i64;
+                        let v = c[k] + o;
+                        if domain.periodic[k] {
+                            cc[k] = v.rem_euclid(m) as usize;
+                        } else if v < 0 || v >= m {
+                            inside = false;
+                        } else {
+                            cc[k] = v as usize;
+                        }
+                    }
+                    if !inside {
+                        continue;
+                    }
+                    let idx = (cc[2] * self.n[1] + cc[1]) * self.n[0] + cc[0];
+                    for (movable, a, y) in &self.cells[idx] {
+                        if *movable && *a == me {
+                            continue;
+                        }
+                        if domain.min_image(x - y).norm_squared() < d * d * 1.0000001 {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    fn relocate(&mut self, domain: &Domain, a: usize, from: &Vec3, to: &Vec3) {
+        let (c0, c1) = (self.cell(domain, from), self.cell(domain, to));
+        let pos = self.cells[c0]
+            .iter()
+            .position(|e| e.0 && e.1 == a)
+            .expect("sphere is in its cell");
+        self.cells[c0].swap_remove(pos);
+        self.cells[c1].push((true, a, *to));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bumpy_wall_matches_the_official_layout() {
+        let w = bumpy_wall(12, 20, 1.0, 0.5);
+        assert_eq!(w.len(), 240);
+        assert_eq!(w[0], Vec3::new(0.5, 0.5, 0.5));
+        assert!((w[1] - Vec3::new(0.0, 1.36602540378444, 0.5)).norm() < 1e-13);
+        assert!((w[12] - Vec3::new(1.5, 0.5, 0.5)).norm() < 1e-13);
+        assert!((w[239] - Vec3::new(19.0, 10.0262794416288, 0.5)).norm() < 1e-13);
+    }
+}
