@@ -7,21 +7,21 @@ use std::path::Path;
 use anyhow::{bail, Context};
 
 use crate::contact::PairForce;
-use crate::neighbor::PairList;
-use crate::sim::Core;
+use crate::sim::{Contact, Core, Snapshot};
 use crate::Vec3;
 
 const MAGIC: &[u8; 8] = b"VERDEMC1";
 
-/// Writes a checkpoint of `core`; `tag` identifies the case (checked on resume).
-pub fn write(path: &Path, core: &Core, tag: &str) -> anyhow::Result<()> {
+/// Writes a checkpoint of a state advanced with time step `dt`; `tag` identifies the case
+/// (checked on resume).
+pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result<()> {
     let mut b = Vec::new();
     b.extend_from_slice(MAGIC);
     b.extend_from_slice(&(tag.len() as u64).to_le_bytes());
     b.extend_from_slice(tag.as_bytes());
     b.extend_from_slice(&core.step.to_le_bytes());
     b.extend_from_slice(&core.time.to_le_bytes());
-    b.extend_from_slice(&core.dt.to_le_bytes());
+    b.extend_from_slice(&dt.to_le_bytes());
     let p = &core.particles;
     b.extend_from_slice(&(p.len() as u64).to_le_bytes());
     let put = |b: &mut Vec<u8>, v: &Vec3| {
@@ -34,13 +34,12 @@ pub fn write(path: &Path, core: &Core, tag: &str) -> anyhow::Result<()> {
             put(&mut b, v);
         }
     }
-    let active: Vec<usize> = (0..core.pairs.p.len()).filter(|&k| core.active[k]).collect();
-    b.extend_from_slice(&(active.len() as u64).to_le_bytes());
-    for k in active {
-        b.extend_from_slice(&core.pairs.p[k].to_le_bytes());
-        b.extend_from_slice(&core.pairs.i[k].to_le_bytes());
-        let o = &core.out[k];
-        for v in [&core.xi[k], &o.f, &o.torque_p, &o.torque_i] {
+    b.extend_from_slice(&(core.contacts.len() as u64).to_le_bytes());
+    for c in &core.contacts {
+        b.extend_from_slice(&c.p.to_le_bytes());
+        b.extend_from_slice(&c.i.to_le_bytes());
+        let o = &c.force;
+        for v in [&c.xi, &o.f, &o.torque_p, &o.torque_i] {
             put(&mut b, v);
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
@@ -92,8 +91,9 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
     if file_tag != tag {
         bail!("{}: checkpoint of case {file_tag:?}, not {tag:?}", path.display());
     }
-    core.step = r.u64()?;
-    core.time = r.f64()?;
+    let mut snap = core.snapshot();
+    snap.step = r.u64()?;
+    snap.time = r.f64()?;
     let dt = r.f64()?;
     if dt.to_bits() != core.dt.to_bits() {
         bail!("{}: checkpoint dt {dt} differs from the case's {}", path.display(), core.dt);
@@ -102,7 +102,7 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
     if n != core.particles.len() {
         bail!("{}: checkpoint has {n} particles, the case {}", path.display(), core.particles.len());
     }
-    let p = &mut core.particles;
+    let p = &mut snap.particles;
     for a in 0..n {
         p.x[a] = r.vec()?;
         p.v[a] = r.vec()?;
@@ -111,29 +111,29 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
         p.t[a] = r.vec()?;
     }
     let contacts = r.u64()? as usize;
-    let mut saved = PairList::default();
-    let mut hist = Vec::with_capacity(contacts);
+    snap.contacts.clear();
     for _ in 0..contacts {
-        saved.p.push(r.u32()?);
-        saved.i.push(r.u32()?);
+        let (cp, ci) = (r.u32()?, r.u32()?);
         let xi = r.vec()?;
         let f = r.vec()?;
         let torque_p = r.vec()?;
         let torque_i = r.vec()?;
         let fn_signed = r.f64()?;
-        hist.push((
+        snap.contacts.push(Contact {
+            p: cp,
+            i: ci,
             xi,
-            PairForce {
+            force: PairForce {
                 f,
                 fn_signed,
                 torque_p,
                 torque_i,
             },
-        ));
+        });
     }
     if r.at != bytes.len() {
         bail!("{}: {} trailing bytes after the checkpoint", path.display(), bytes.len() - r.at);
     }
-    core.restore_contacts(&saved.p, &saved.i, &hist);
+    core.restore(&snap);
     Ok(core.step)
 }

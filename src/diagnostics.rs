@@ -1,7 +1,7 @@
 //! Per-save diagnostics: kinetic energy of the free particles, contact count, and the total
 //! force the free particles exert on each wall group.
 
-use crate::sim::Core;
+use crate::sim::Snapshot;
 use crate::state::Motion;
 use crate::Vec3;
 
@@ -26,8 +26,8 @@ pub const CSV_HEADER: &str =
     "save,step,time,ke_trans,ke_rot,contacts,bottom_fx,bottom_fz,top_fx,top_fz\n";
 
 impl Diagnostics {
-    /// Diagnostics of the current state (forces of the last evaluation).
-    pub fn of(core: &Core, save: u64) -> Self {
+    /// Diagnostics of a state (forces of the last evaluation).
+    pub fn of(core: &Snapshot, save: u64) -> Self {
         let p = &core.particles;
         let (mut ke_trans, mut ke_rot) = (0.0, 0.0);
         for a in 0..p.len() {
@@ -37,14 +37,9 @@ impl Diagnostics {
             }
         }
         let mut wall_force = [Vec3::zeros(); 2];
-        let mut contacts = 0;
-        for k in 0..core.pairs.p.len() {
-            if !core.active[k] {
-                continue;
-            }
-            contacts += 1;
-            let (pp, ii) = (core.pairs.p[k] as usize, core.pairs.i[k] as usize);
-            let f = core.out[k].f;
+        for c in &core.contacts {
+            let (pp, ii) = (c.p as usize, c.i as usize);
+            let f = c.force.f;
             if let Motion::Prescribed(g) = p.motion[pp] {
                 wall_force[g.min(1) as usize] += f;
             }
@@ -58,7 +53,7 @@ impl Diagnostics {
             time: core.time,
             ke_trans,
             ke_rot,
-            contacts,
+            contacts: core.contacts.len(),
             wall_force,
         }
     }

@@ -57,14 +57,12 @@ impl Domain {
     /// boundaries do after each drift (one shift by the period, no modulo).
     #[inline(always)]
     pub fn wrap(&self, x: &mut Vec3) {
+        // x − (up − down) with up, down ∈ {0, L} chosen without branches; x − 0 = x bit for bit.
         for k in 0..3 {
-            let l = self.period[k];
-            if l > 0.0 {
-                if x[k] >= self.hi[k] {
-                    x[k] -= l;
-                } else if x[k] < self.lo[k] {
-                    x[k] += l;
-                }
+            if self.periodic[k] {
+                let up = if x[k] >= self.hi[k] { self.period[k] } else { 0.0 };
+                let down = if x[k] < self.lo[k] { self.period[k] } else { 0.0 };
+                x[k] -= up - down;
             }
         }
     }

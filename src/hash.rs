@@ -4,10 +4,10 @@
 
 use sha2::{Digest, Sha256};
 
-use crate::sim::Core;
+use crate::sim::Snapshot;
 
 /// Hex SHA-256 of the state.
-pub fn state_hash(core: &Core) -> String {
+pub fn state_hash(core: &Snapshot) -> String {
     let mut h = Sha256::new();
     let p = &core.particles;
     for a in 0..p.len() {
@@ -17,14 +17,11 @@ pub fn state_hash(core: &Core) -> String {
             }
         }
     }
-    // The pair list is in canonical (P, I) order; only contacts carry history.
-    for k in 0..core.pairs.p.len() {
-        if core.active[k] {
-            h.update(core.pairs.p[k].to_le_bytes());
-            h.update(core.pairs.i[k].to_le_bytes());
-            for c in 0..3 {
-                h.update(core.xi[k][c].to_le_bytes());
-            }
+    for c in &core.contacts {
+        h.update(c.p.to_le_bytes());
+        h.update(c.i.to_le_bytes());
+        for k in 0..3 {
+            h.update(c.xi[k].to_le_bytes());
         }
     }
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()

@@ -171,7 +171,7 @@ fn real_main() -> anyhow::Result<()> {
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;
             engine.advance(steps);
-            println!("{}", hash::state_hash(engine.core()));
+            println!("{}", hash::state_hash(&engine.core().snapshot()));
         }
     }
     Ok(())

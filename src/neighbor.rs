@@ -1,6 +1,10 @@
-//! Verlet pair list with a skin, built on a cell grid with periodic images; pairs in canonical
-//! order (sorted by lower index, then higher index), and for each particle the list of its
-//! pair slots sorted by partner id, which fixes the order in which its forces are summed.
+//! Verlet pair list with a skin, built on a cell grid with periodic images.
+//!
+//! At every build the particles are re-ordered in memory by cell (x slowest), so that a thread
+//! owning a contiguous range of them owns a slab of space and touches few particles of the other
+//! threads. The order of floating-point sums never depends on that memory order: each pair is
+//! oriented by original ids (P = lower id), and each particle's list of pairs is sorted by its
+//! partners' original ids.
 
 use crate::domain::Domain;
 use crate::Vec3;
@@ -15,13 +19,17 @@ pub enum Search {
     AllPairs,
 }
 
-/// The pair list. Pair `k` joins `p[k] < i[k]`; pairs are sorted by `(p, i)`.
+/// The pair list, in memory indices. Pair `k` joins `p[k]` and `i[k]` with
+/// `id[p[k]] < id[i[k]]`; as built, pairs are grouped by their lower memory index (`owner`),
+/// increasing (the simulation then re-sorts them within each thread's share).
 #[derive(Clone, Debug, Default)]
 pub struct PairList {
-    /// Lower index of each pair (P).
+    /// Memory index of the lower-id particle of each pair (P).
     pub p: Vec<u32>,
-    /// Higher index of each pair (I).
+    /// Memory index of the higher-id particle of each pair (I).
     pub i: Vec<u32>,
+    /// Pairs owned by memory index a: `owner_start[a]..owner_start[a+1]`.
+    pub owner_start: Vec<u32>,
     /// `adj[adj_start[a]..adj_start[a+1]]` are particle `a`'s pair slots, sorted by partner id;
     /// each entry is `slot << 1 | role`, role 0 when `a` is P and 1 when `a` is I.
     pub adj_start: Vec<u32>,
@@ -36,10 +44,8 @@ pub struct NeighborBuilder {
     /// Edge of a cell; ≥ 2 r_max + skin (length).
     pub cell: f64,
     pub search: Search,
+    keys: Vec<(u32, u32)>,
     cell_start: Vec<u32>,
-    cell_items: Vec<u32>,
-    cell_of: Vec<u32>,
-    fill: Vec<u32>,
     partners: Vec<u32>,
 }
 
@@ -51,99 +57,111 @@ impl NeighborBuilder {
             skin,
             cell: cell.max(2.0 * r_max + skin),
             search,
+            keys: Vec::new(),
             cell_start: Vec::new(),
-            cell_items: Vec::new(),
-            cell_of: Vec::new(),
-            fill: Vec::new(),
             partners: Vec::new(),
         }
     }
 
-    /// Rebuilds `list` for positions `x` and radii `radius`; `interacts(a, b)` excludes pairs
-    /// that never interact (wall–wall). A pair enters when |x_P − x_I| < r_P + r_I + skin.
+    /// The memory order for positions `x`: indices sorted by (cell, id), x-axis slowest.
+    /// `order[new] = old`.
+    pub fn order(&mut self, domain: &Domain, x: &[Vec3], id: &[u32], order: &mut Vec<u32>) {
+        let grid = Grid::new(domain, self.cell);
+        self.keys.clear();
+        self.keys
+            .extend((0..x.len()).map(|a| (grid.index(grid.coords(domain, &x[a])) as u32, id[a])));
+        order.clear();
+        order.extend(0..x.len() as u32);
+        let keys = &self.keys;
+        order.sort_unstable_by_key(|&a| keys[a as usize]);
+    }
+
+    /// Rebuilds the pairs of `list` for particles already in [`NeighborBuilder::order`]'s
+    /// order, grouped by owner; the per-particle lists are made by [`PairList::index`] once the
+    /// caller has settled the pairs' order. A pair enters when |x_P − x_I| < r_P + r_I + skin and
+    /// `interacts(a, b)` (wall–wall pairs never do).
     pub fn build(
         &mut self,
         list: &mut PairList,
         domain: &Domain,
         x: &[Vec3],
         radius: &[f64],
+        id: &[u32],
         interacts: impl Fn(usize, usize) -> bool,
     ) {
         let n = x.len();
         list.p.clear();
         list.i.clear();
+        list.owner_start.clear();
+        list.owner_start.push(0);
         let skin = self.skin;
         let accept = |a: usize, b: usize| {
             let cut = radius[a] + radius[b] + skin;
             interacts(a, b) && domain.min_image(x[a] - x[b]).norm_squared() < cut * cut
+        };
+        let push = |list: &mut PairList, a: usize, b: usize| {
+            if id[a] < id[b] {
+                list.p.push(a as u32);
+                list.i.push(b as u32);
+            } else {
+                list.p.push(b as u32);
+                list.i.push(a as u32);
+            }
         };
         match self.search {
             Search::AllPairs => {
                 for a in 0..n {
                     for b in a + 1..n {
                         if accept(a, b) {
-                            list.p.push(a as u32);
-                            list.i.push(b as u32);
+                            push(list, a, b);
                         }
                     }
+                    list.owner_start.push(list.p.len() as u32);
                 }
             }
             Search::Cells => {
                 let grid = Grid::new(domain, self.cell);
-                self.bin(&grid, domain, x);
+                // Particles are sorted by cell: each cell is a contiguous range.
+                self.cell_start.clear();
+                self.cell_start.resize(grid.count() + 1, 0);
+                for p in x {
+                    self.cell_start[grid.index(grid.coords(domain, p)) + 1] += 1;
+                }
+                for c in 0..grid.count() {
+                    self.cell_start[c + 1] += self.cell_start[c];
+                }
                 let mut partners = std::mem::take(&mut self.partners);
                 for a in 0..n {
                     partners.clear();
-                    let c = grid.coords(domain, &x[a]);
-                    for nc in grid.neighbours(c) {
-                        let (s, e) = (self.cell_start[nc], self.cell_start[nc + 1]);
-                        for &b in &self.cell_items[s as usize..e as usize] {
-                            if b as usize > a && accept(a, b as usize) {
-                                partners.push(b);
+                    grid.for_each_neighbour(grid.coords(domain, &x[a]), |nc| {
+                        let (s, e) = (self.cell_start[nc] as usize, self.cell_start[nc + 1] as usize);
+                        for b in s.max(a + 1)..e {
+                            if accept(a, b) {
+                                partners.push(b as u32);
                             }
                         }
-                    }
+                    });
                     partners.sort_unstable();
                     for &b in &partners {
-                        list.p.push(a as u32);
-                        list.i.push(b);
+                        push(list, a, b as usize);
                     }
+                    list.owner_start.push(list.p.len() as u32);
                 }
                 self.partners = partners;
             }
         }
-        build_adjacency(list, n, &mut self.fill);
-    }
-
-    /// Counting sort of particle indices into cells.
-    fn bin(&mut self, grid: &Grid, domain: &Domain, x: &[Vec3]) {
-        let ncell = grid.count();
-        self.cell_start.clear();
-        self.cell_start.resize(ncell + 1, 0);
-        self.cell_of.clear();
-        self.cell_of
-            .extend(x.iter().map(|p| grid.index(grid.coords(domain, p)) as u32));
-        for &c in &self.cell_of {
-            self.cell_start[c as usize + 1] += 1;
-        }
-        for c in 0..ncell {
-            self.cell_start[c + 1] += self.cell_start[c];
-        }
-        self.cell_items.clear();
-        self.cell_items.resize(x.len(), 0);
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.cell_start);
-        for (a, &c) in self.cell_of.iter().enumerate() {
-            self.cell_items[self.fill[c as usize] as usize] = a as u32;
-            self.fill[c as usize] += 1;
-        }
     }
 }
 
-/// Fills the per-particle slot lists. Iterating pairs in (P, I) order visits, for particle a,
-/// first the pairs where a is I (partners < a, increasing) and then those where a is P
-/// (partners > a, increasing): each list comes out sorted by partner id.
-fn build_adjacency(list: &mut PairList, n: usize, fill: &mut Vec<u32>) {
+impl PairList {
+    /// Fills the per-particle slot lists of `n` particles, each sorted by the partners'
+    /// original ids `id`; `fill` is scratch.
+    pub fn index(&mut self, n: usize, id: &[u32], fill: &mut Vec<u32>) {
+        build_adjacency(self, n, id, fill);
+    }
+}
+
+fn build_adjacency(list: &mut PairList, n: usize, id: &[u32], fill: &mut Vec<u32>) {
     list.adj_start.clear();
     list.adj_start.resize(n + 1, 0);
     for k in 0..list.p.len() {
@@ -164,36 +182,21 @@ fn build_adjacency(list: &mut PairList, n: usize, fill: &mut Vec<u32>) {
         list.adj[fill[i] as usize] = ((k as u32) << 1) | 1;
         fill[i] += 1;
     }
-}
-
-/// Copies per-pair history from an old list to a new one, matching pairs by `(p, i)`; pairs
-/// that are new get `T::default()`. Both lists are in canonical order, so one merge pass does.
-pub fn carry_history<T: Copy + Default>(
-    old_p: &[u32],
-    old_i: &[u32],
-    old_h: &[T],
-    new: &PairList,
-    new_h: &mut Vec<T>,
-) {
-    new_h.clear();
-    new_h.resize(new.p.len(), T::default());
-    let key = |p: u32, i: u32| ((p as u64) << 32) | i as u64;
-    let mut o = 0;
-    for k in 0..new.p.len() {
-        let kn = key(new.p[k], new.i[k]);
-        while o < old_p.len() && key(old_p[o], old_i[o]) < kn {
-            o += 1;
-        }
-        if o < old_p.len() && key(old_p[o], old_i[o]) == kn {
-            new_h[k] = old_h[o];
-        }
+    let (p, i) = (&list.p, &list.i);
+    let partner_id = |e: u32| {
+        let k = (e >> 1) as usize;
+        id[if e & 1 == 0 { i[k] } else { p[k] } as usize]
+    };
+    for a in 0..n {
+        let seg = &mut list.adj[list.adj_start[a] as usize..list.adj_start[a + 1] as usize];
+        seg.sort_unstable_by_key(|&e| partner_id(e));
     }
 }
 
-/// Cell grid over the box; periodic axes wrap, others clamp.
+/// Cell grid over the box; periodic axes wrap, others clamp. Cell index has x slowest.
 struct Grid {
     n: [usize; 3],
-    edge: [f64; 3],
+    inv_edge: [f64; 3],
     periodic: [bool; 3],
 }
 
@@ -201,14 +204,14 @@ impl Grid {
     fn new(domain: &Domain, cell: f64) -> Self {
         let l = domain.lengths();
         let mut n = [1usize; 3];
-        let mut edge = [0.0; 3];
+        let mut inv_edge = [0.0; 3];
         for k in 0..3 {
             n[k] = ((l[k] / cell).floor() as usize).max(1);
-            edge[k] = l[k] / n[k] as f64;
+            inv_edge[k] = n[k] as f64 / l[k];
         }
         Grid {
             n,
-            edge,
+            inv_edge,
             periodic: domain.periodic,
         }
     }
@@ -220,47 +223,44 @@ impl Grid {
     fn coords(&self, domain: &Domain, x: &Vec3) -> [usize; 3] {
         let mut c = [0usize; 3];
         for k in 0..3 {
-            let f = ((x[k] - domain.lo[k]) / self.edge[k]).floor();
+            let f = ((x[k] - domain.lo[k]) * self.inv_edge[k]).floor();
             c[k] = (f.max(0.0) as usize).min(self.n[k] - 1);
         }
         c
     }
 
     fn index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.n[1] + c[1]) * self.n[0] + c[0]
+        (c[0] * self.n[1] + c[1]) * self.n[2] + c[2]
     }
 
-    /// The distinct cells adjacent to (and including) cell `c`.
-    fn neighbours(&self, c: [usize; 3]) -> impl Iterator<Item = usize> {
-        let mut out = [usize::MAX; 27];
-        let mut len = 0;
-        for dz in -1i64..=1 {
-            for dy in -1i64..=1 {
-                for dx in -1i64..=1 {
-                    let mut cc = [0usize; 3];
-                    let mut inside = true;
-                    for (k, d) in [dx, dy, dz].into_iter().enumerate() {
-                        let m = self.n[k] as i64;
-                        let v = c[k] as i64 + d;
-                        if self.periodic[k] {
-                            cc[k] = v.rem_euclid(m) as usize;
-                        } else if v < 0 || v >= m {
-                            inside = false;
-                        } else {
-                            cc[k] = v as usize;
-                        }
-                    }
-                    if inside {
-                        let idx = self.index(cc);
-                        if !out[..len].contains(&idx) {
-                            out[len] = idx;
-                            len += 1;
-                        }
-                    }
+    /// Calls `f` once for each distinct cell adjacent to (or equal to) cell `c`.
+    fn for_each_neighbour(&self, c: [usize; 3], mut f: impl FnMut(usize)) {
+        let mut axis = [[0usize; 3]; 3];
+        let mut len = [0usize; 3];
+        for k in 0..3 {
+            let m = self.n[k] as i64;
+            for d in -1i64..=1 {
+                let v = c[k] as i64 + d;
+                let v = if self.periodic[k] {
+                    v.rem_euclid(m)
+                } else if v < 0 || v >= m {
+                    continue;
+                } else {
+                    v
+                } as usize;
+                if !axis[k][..len[k]].contains(&v) {
+                    axis[k][len[k]] = v;
+                    len[k] += 1;
                 }
             }
         }
-        out.into_iter().take(len)
+        for &cx in &axis[0][..len[0]] {
+            for &cy in &axis[1][..len[1]] {
+                for &cz in &axis[2][..len[2]] {
+                    f(self.index([cx, cy, cz]));
+                }
+            }
+        }
     }
 }
 
@@ -269,7 +269,7 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
 
-    fn random_scene(n: usize, seed: u64) -> (Domain, Vec<Vec3>, Vec<f64>) {
+    fn random_scene(n: usize, seed: u64) -> (Domain, Vec<Vec3>, Vec<f64>, Vec<u32>) {
         let domain = Domain::new(Vec3::zeros(), Vec3::new(6.0, 4.0, 7.0), [true, true, false]);
         let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
         let x = (0..n)
@@ -281,45 +281,57 @@ mod tests {
                 )
             })
             .collect();
-        (domain, x, vec![0.5; n])
+        (domain, x, vec![0.5; n], (0..n as u32).collect())
+    }
+
+    fn sorted_id_pairs(l: &PairList, id: &[u32]) -> Vec<(u32, u32)> {
+        let mut v: Vec<(u32, u32)> = (0..l.p.len())
+            .map(|k| (id[l.p[k] as usize], id[l.i[k] as usize]))
+            .collect();
+        v.sort_unstable();
+        v
     }
 
     #[test]
-    fn cell_search_finds_exactly_the_all_pairs_list_in_canonical_order() {
-        let (domain, x, r) = random_scene(300, 7);
-        let mut a = PairList::default();
-        let mut b = PairList::default();
-        NeighborBuilder::new(0.3, 0.0, 0.5, Search::Cells).build(&mut a, &domain, &x, &r, |_, _| true);
-        NeighborBuilder::new(0.3, 0.0, 0.5, Search::AllPairs).build(&mut b, &domain, &x, &r, |_, _| true);
-        assert!(!a.p.is_empty());
-        assert_eq!(a.p, b.p);
-        assert_eq!(a.i, b.i);
+    fn cell_search_finds_exactly_the_all_pairs_list_with_pairs_oriented_by_id() {
+        let (domain, x, r, id) = random_scene(300, 7);
+        let mut b = NeighborBuilder::new(0.3, 0.0, 0.5, Search::Cells);
+        let mut order = Vec::new();
+        b.order(&domain, &x, &id, &mut order);
+        let xs: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
+        let ids: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
+        let mut cells = PairList::default();
+        b.build(&mut cells, &domain, &xs, &r, &ids, |_, _| true);
+        let mut all = PairList::default();
+        NeighborBuilder::new(0.3, 0.0, 0.5, Search::AllPairs).build(&mut all, &domain, &x, &r, &id, |_, _| true);
+        assert_eq!(*cells.owner_start.last().unwrap() as usize, cells.p.len());
+        assert!(!cells.p.is_empty());
+        assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
+        assert!((0..cells.p.len()).all(|k| ids[cells.p[k] as usize] < ids[cells.i[k] as usize]));
     }
 
     #[test]
-    fn adjacency_lists_are_sorted_by_partner() {
-        let (domain, x, r) = random_scene(200, 3);
+    fn adjacency_lists_are_sorted_by_partner_id() {
+        let (domain, x, r, _) = random_scene(200, 3);
+        // a scrambled id assignment: memory order is not id order
+        let id: Vec<u32> = (0..200u32).map(|a| (a * 77) % 200).collect();
+        let mut b = NeighborBuilder::new(0.5, 0.0, 0.5, Search::Cells);
+        let mut order = Vec::new();
+        b.order(&domain, &x, &id, &mut order);
+        let x: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
+        let id: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
         let mut l = PairList::default();
-        NeighborBuilder::new(0.5, 0.0, 0.5, Search::Cells).build(&mut l, &domain, &x, &r, |_, _| true);
+        b.build(&mut l, &domain, &x, &r, &id, |_, _| true);
+        l.index(x.len(), &id, &mut Vec::new());
         for a in 0..x.len() {
             let partners: Vec<u32> = l.adj[l.adj_start[a] as usize..l.adj_start[a + 1] as usize]
                 .iter()
                 .map(|&e| {
                     let k = (e >> 1) as usize;
-                    if e & 1 == 0 { l.i[k] } else { l.p[k] }
+                    id[if e & 1 == 0 { l.i[k] } else { l.p[k] } as usize]
                 })
                 .collect();
             assert!(partners.windows(2).all(|w| w[0] < w[1]), "particle {a}");
         }
-    }
-
-    #[test]
-    fn history_follows_its_pair_across_a_rebuild() {
-        let mut new = PairList::default();
-        new.p = vec![0, 0, 2];
-        new.i = vec![1, 3, 5];
-        let mut h = Vec::new();
-        carry_history(&[0, 2, 4], &[3, 5, 6], &[1.0, 2.0, 3.0], &new, &mut h);
-        assert_eq!(h, vec![0.0, 1.0, 2.0]);
     }
 }

@@ -89,7 +89,8 @@ pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow:
         if opts.checkpoint_every > 0 && step % opts.checkpoint_every == 0 && step != start_step {
             crate::checkpoint::write(
                 &checkpoint_path(&opts.out_dir, &opts.name),
-                engine.core(),
+                &engine.core().snapshot(),
+                engine.core().dt,
                 &opts.tag,
             )?;
         }
@@ -117,7 +118,7 @@ pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow:
     Ok(RunSummary {
         step: core.step,
         time: core.time,
-        hash: crate::hash::state_hash(core),
+        hash: crate::hash::state_hash(&core.snapshot()),
         steps_run: core.step - start_step,
         seconds: t0.elapsed().as_secs_f64(),
         stages: core.times,
@@ -126,7 +127,7 @@ pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow:
 }
 
 fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
-    let core = engine.core();
+    let core = &engine.core().snapshot();
     let k = core.step / opts.save_every;
     let data = save_path(&opts.out_dir, &opts.name, "data", k);
     atomic::write(&data, mercury::data_text(core).as_bytes())

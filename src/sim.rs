@@ -13,15 +13,15 @@
 //! Steps 4 of one step and 1 of the next touch only one particle each, so they run fused in one
 //! pass. With T threads every thread runs this loop on its own particles and pairs, and the
 //! threads meet at a barrier after the per-particle pass and after the pair pass: two barriers
-//! per step. No float is ever summed in an order that depends on the thread count, so results
-//! are bitwise identical for any number of threads, any skin and any cell size.
+//! per step. No float is ever summed in an order that depends on the thread count, the memory
+//! order of the particles, the skin or the cell size, so results are bitwise identical for all.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use crate::contact::{ContactLaw, PairForce, PairInput, PairKinematics};
+use crate::contact::{ContactLaw, PairForce, PairInput};
 use crate::domain::Domain;
-use crate::neighbor::{carry_history, NeighborBuilder, PairList};
+use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::{Motion, Particles};
 use crate::team::{balanced_ranges, Shared, SpinBarrier};
 use crate::Vec3;
@@ -29,7 +29,7 @@ use crate::Vec3;
 /// Wall-clock time spent in each stage, in nanoseconds, measured on thread 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StageTimes {
-    /// Pair-list rebuilds.
+    /// Pair-list rebuilds (including the re-ordering of particles in memory).
     pub neighbor: u64,
     /// Pair forces.
     pub forces: u64,
@@ -41,10 +41,34 @@ pub struct StageTimes {
     pub rebuilds: u64,
 }
 
-/// Everything a step advances, independent of the contact law.
+/// One contact of a [`Snapshot`], by original particle indices `p < i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    pub p: u32,
+    pub i: u32,
+    /// Elastic tangential displacement (length).
+    pub xi: Vec3,
+    /// Force and torques of the last evaluation (force on P).
+    pub force: PairForce,
+}
+
+/// The state in canonical order: particles by id, contacts sorted by `(p, i)`.
+#[derive(Clone, Debug)]
+pub struct Snapshot {
+    pub step: u64,
+    pub time: f64,
+    pub domain: Domain,
+    pub particles: Particles,
+    pub contacts: Vec<Contact>,
+}
+
+/// Everything a step advances, independent of the contact law. Particle arrays are in memory
+/// order (re-ordered by cell at every pair-list build); use [`Core::snapshot`] for id order.
 pub struct Core {
     pub domain: Domain,
     pub particles: Particles,
+    /// Original index (0-based id) of each particle in memory order.
+    pub id: Vec<u32>,
     /// Time step (time units).
     pub dt: f64,
     /// Gravity (acceleration), `None` when the case has none: no gravity pass at all.
@@ -74,16 +98,29 @@ pub struct Core {
 
 #[derive(Default)]
 struct Scratch {
-    old_p: Vec<u32>,
-    old_i: Vec<u32>,
+    order: Vec<u32>,
+    vec3: Vec<Vec3>,
+    real: Vec<f64>,
+    motion: Vec<Motion>,
+    index: Vec<u32>,
+    old_keys: Vec<(u64, u32)>,
     old_xi: Vec<Vec3>,
-    old_active: Vec<bool>,
+    fill: Vec<u32>,
+    pair_keys: Vec<(bool, f64, u32)>,
     particle_ranges: Vec<(usize, usize)>,
-    pair_ranges: Vec<(usize, usize)>,
+    /// Each thread's pairs `(a, m, b)`: interior pairs `a..m`, then pairs across a periodic
+    /// boundary `m..b`, each part sorted by gap.
+    pair_ranges: Vec<(usize, usize, usize)>,
+    /// Gap |r| − (r_P + r_I) of each pair at the build (length).
+    gap: Vec<f64>,
+}
+
+fn key(p: u32, i: u32) -> u64 {
+    ((p as u64) << 32) | i as u64
 }
 
 impl Core {
-    /// A state at step 0, time 0, with no forces evaluated yet.
+    /// A state at step 0, time 0, with no forces evaluated yet; particles in id order.
     pub fn new(
         domain: Domain,
         particles: Particles,
@@ -92,7 +129,9 @@ impl Core {
         builder: NeighborBuilder,
         threads: usize,
     ) -> Self {
+        let threads = threads.max(1);
         Core {
+            id: (0..particles.len() as u32).collect(),
             domain,
             particles,
             dt,
@@ -105,10 +144,13 @@ impl Core {
             out: Vec::new(),
             forces_ready: false,
             moved_bound: 0.0,
-            threads: threads.max(1),
+            threads,
             times: StageTimes::default(),
             builder,
-            scratch: Scratch::default(),
+            scratch: Scratch {
+                particle_ranges: vec![(0, 0); threads],
+                ..Scratch::default()
+            },
         }
     }
 
@@ -117,12 +159,10 @@ impl Core {
         self.builder.skin
     }
 
-    /// Rebuilds the pair list at the current positions, keeping every pair's history.
-    pub fn rebuild(&mut self) {
-        if self.scratch.particle_ranges.is_empty() {
-            self.scratch.particle_ranges = vec![(0, 0); self.threads];
-        }
-        let mut l = ListState {
+    fn list_state(&mut self) -> ListState<'_> {
+        ListState {
+            particles: &mut self.particles,
+            id: &mut self.id,
             pairs: &mut self.pairs,
             xi: &mut self.xi,
             active: &mut self.active,
@@ -130,57 +170,92 @@ impl Core {
             builder: &mut self.builder,
             scratch: &mut self.scratch,
             times: &mut self.times,
-            motion: &self.particles.motion,
-        };
-        l.rebuild(
-            &self.domain,
-            &self.particles.x,
-            &self.particles.radius,
-            &self.particles.inv_mass,
-        );
+        }
     }
 
-    /// Rebuilds the pair list and sets the listed contacts (canonical order) as active with
+    /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
+    pub fn rebuild(&mut self) {
+        let domain = self.domain.clone();
+        self.list_state().rebuild(&domain);
+        self.moved_bound = 0.0;
+    }
+
+    /// Rebuilds the pair list and sets the given contacts (by original ids) as active with
     /// their history and force; used when resuming from a checkpoint.
-    pub fn restore_contacts(&mut self, p: &[u32], i: &[u32], contacts: &[(Vec3, PairForce)]) {
-        self.xi.clear();
-        self.active.clear();
-        self.pairs = PairList::default();
+    pub fn restore_contacts(&mut self, contacts: &[Contact]) {
+        for k in 0..self.active.len() {
+            self.active[k] = false;
+            self.xi[k] = Vec3::zeros();
+        }
         self.rebuild();
-        let saved: Vec<Option<(Vec3, PairForce)>> = contacts.iter().copied().map(Some).collect();
-        let mut slots = Vec::new();
-        carry_history(p, i, &saved, &self.pairs, &mut slots);
-        for (k, slot) in slots.into_iter().enumerate() {
-            if let Some((xi, out)) = slot {
-                self.xi[k] = xi;
-                self.out[k] = out;
+        let mut slot = std::collections::HashMap::new();
+        for k in 0..self.pairs.p.len() {
+            let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+            slot.insert(key(p, i), k);
+        }
+        for c in contacts {
+            if let Some(&k) = slot.get(&key(c.p, c.i)) {
+                self.xi[k] = c.xi;
+                self.out[k] = c.force;
                 self.active[k] = true;
             }
         }
         self.forces_ready = true;
     }
 
-    /// The contact geometry of pair `k` at the current positions (velocities not included), or
-    /// `None` when it is not touching. Used for output; recomputes exactly what the force pass
-    /// computed for n, δ and the contact point.
-    pub fn pair_geometry(&self, k: usize) -> Option<PairKinematics> {
-        let (p, i) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
-        let x = &self.particles.x;
-        PairInput {
-            r: self.domain.min_image(x[p] - x[i]),
-            rad_p: self.particles.radius[p],
-            rad_i: self.particles.radius[i],
-            v_p: Vec3::zeros(),
-            v_i: Vec3::zeros(),
-            w_p: Vec3::zeros(),
-            w_i: Vec3::zeros(),
-        }
-        .kinematics()
-    }
-
     /// Number of pairs in contact at the last force evaluation.
     pub fn contact_count(&self) -> usize {
         self.active.iter().filter(|a| **a).count()
+    }
+
+    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
+    pub fn snapshot(&self) -> Snapshot {
+        let n = self.particles.len();
+        let mut pos = vec![0usize; n];
+        for (a, &id) in self.id.iter().enumerate() {
+            pos[id as usize] = a;
+        }
+        let src = &self.particles;
+        let mut particles = Particles::default();
+        for &a in &pos {
+            particles.x.push(src.x[a]);
+            particles.v.push(src.v[a]);
+            particles.w.push(src.w[a]);
+            particles.radius.push(src.radius[a]);
+            particles.inv_mass.push(src.inv_mass[a]);
+            particles.inv_inertia.push(src.inv_inertia[a]);
+            particles.motion.push(src.motion[a]);
+            particles.f.push(src.f[a]);
+            particles.t.push(src.t[a]);
+        }
+        let mut contacts: Vec<Contact> = (0..self.pairs.p.len())
+            .filter(|&k| self.active[k])
+            .map(|k| Contact {
+                p: self.id[self.pairs.p[k] as usize],
+                i: self.id[self.pairs.i[k] as usize],
+                xi: self.xi[k],
+                force: self.out[k],
+            })
+            .collect();
+        contacts.sort_unstable_by_key(|c| key(c.p, c.i));
+        Snapshot {
+            step: self.step,
+            time: self.time,
+            domain: self.domain.clone(),
+            particles,
+            contacts,
+        }
+    }
+
+    /// Overwrites the dynamic state from a canonical snapshot of the same scene.
+    pub fn restore(&mut self, s: &Snapshot) {
+        let n = self.particles.len();
+        assert_eq!(n, s.particles.len(), "snapshot of another scene");
+        self.id = (0..n as u32).collect();
+        self.particles = s.particles.clone();
+        self.step = s.step;
+        self.time = s.time;
+        self.restore_contacts(&s.contacts);
     }
 }
 
@@ -209,6 +284,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if !self.core.forces_ready {
             self.initial_forces();
         }
+        if self.core.pairs.owner_start.is_empty() {
+            self.core.rebuild();
+        }
         match (L::TANGENTIAL, self.core.gravity.is_some()) {
             (true, false) => self.run::<true, false>(steps),
             (true, true) => self.run::<true, true>(steps),
@@ -218,20 +296,13 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
 }
 
-/// Shared views of the arrays a step touches, handed to every thread.
+/// What every thread of a step reads: the law, the box and the shared particle arrays.
 struct StepView<'a, L> {
     law: &'a L,
     domain: &'a Domain,
     dt: f64,
     gravity: Vec3,
-    x: Shared<&'a mut [Vec3]>,
-    v: Shared<&'a mut [Vec3]>,
-    w: Shared<&'a mut [Vec3]>,
-    f: Shared<&'a mut [Vec3]>,
-    t: Shared<&'a mut [Vec3]>,
-    radius: &'a [f64],
-    inv_mass: &'a [f64],
-    inv_inertia: &'a [f64],
+    particles: Shared<&'a mut Particles>,
 }
 
 impl<L: ContactLaw> Simulation<L> {
@@ -243,27 +314,14 @@ impl<L: ContactLaw> Simulation<L> {
     fn initial_forces(&mut self) {
         self.core.rebuild();
         let c = &mut self.core;
-        let n = c.pairs.p.len();
-        for k in 0..n {
-            pair_force(
-                &self.law,
-                &c.domain,
-                c.dt,
-                k,
-                &c.pairs,
-                &c.particles.x,
-                &c.particles.v,
-                &c.particles.w,
-                &c.particles.radius,
-                &mut c.xi[k],
-                &mut c.active[k],
-                &mut c.out[k],
-            );
+        let pt = &mut c.particles;
+        for k in 0..c.pairs.p.len() {
+            pair_force::<L, true>(&self.law, &c.domain, c.dt, k, &c.pairs, pt, &mut c.xi[k], &mut c.active[k], &mut c.out[k]);
         }
-        for a in 0..c.particles.len() {
+        for a in 0..pt.len() {
             let (f, t) = gather(a, &c.pairs, &c.active, &c.out);
-            c.particles.f[a] = f;
-            c.particles.t[a] = t;
+            pt.f[a] = f;
+            pt.t[a] = t;
         }
         c.forces_ready = true;
     }
@@ -272,54 +330,23 @@ impl<L: ContactLaw> Simulation<L> {
         if steps == 0 {
             return;
         }
-        let threads = self.core.threads;
+        let core = &mut self.core;
+        let threads = core.threads;
         let barrier = SpinBarrier::new(threads);
         let vmax2: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
-        let core = &mut self.core;
-        let gravity = core.gravity.unwrap_or_else(Vec3::zeros);
         let skin = core.skin();
         let bound0 = core.moved_bound;
-        // The pair list and the partitions change at a rebuild (done by thread 0 alone while
-        // the others wait at a barrier); the particle arrays are shared by index ranges.
-        let Core {
-            domain,
-            particles,
-            dt,
-            pairs,
-            xi,
-            active,
-            out,
-            times,
-            builder,
-            scratch,
-            threads: _,
-            ..
-        } = core;
+        let domain = core.domain.clone();
         let view = StepView {
             law: &self.law,
-            domain,
-            dt: *dt,
-            gravity,
-
-            x: Shared::new(&mut particles.x[..]),
-            v: Shared::new(&mut particles.v[..]),
-            w: Shared::new(&mut particles.w[..]),
-            f: Shared::new(&mut particles.f[..]),
-            t: Shared::new(&mut particles.t[..]),
-            radius: &particles.radius,
-            inv_mass: &particles.inv_mass,
-            inv_inertia: &particles.inv_inertia,
+            domain: &domain,
+            dt: core.dt,
+            gravity: core.gravity.unwrap_or_else(Vec3::zeros),
+            particles: Shared::new(unsafe { &mut *(&mut core.particles as *mut Particles) }),
         };
-        let list = Shared::new(ListState {
-            pairs,
-            xi,
-            active,
-            out,
-            builder,
-            scratch,
-            times,
-            motion: &particles.motion,
-        });
+        // The list state also reaches the particles (a rebuild re-orders them); thread 0 uses it
+        // for that alone, while the other threads wait at a barrier.
+        let list = Shared::new(core.list_state());
         let work = |tid: usize| {
             let mut local = StageTimes::default();
             let mut clock = Instant::now();
@@ -331,9 +358,12 @@ impl<L: ContactLaw> Simulation<L> {
                 }
             };
             let mut bound = bound0;
+            // Ends of the live prefixes of this thread's interior and boundary pairs.
+            let mut live: Option<(usize, usize)> = None;
             for s in 0..steps {
                 // SAFETY (all blocks below): phases are separated by barriers; in each phase a
-                // thread writes only its own particle range or pair range.
+                // thread writes only its own particle range or pair range, and a rebuild runs on
+                // thread 0 alone between two barriers.
                 let v2 = unsafe {
                     let l = list.get();
                     let (a, b) = l.scratch.particle_ranges[tid];
@@ -351,23 +381,30 @@ impl<L: ContactLaw> Simulation<L> {
                 bound += m.sqrt() * view.dt;
                 if bound > 0.5 * skin {
                     bound = 0.0;
+                    live = None;
                     if tid == 0 {
-                        unsafe {
-                            list.get().rebuild(
-                                view.domain,
-                                view.x.get(),
-                                view.radius,
-                                view.inv_mass,
-                            )
-                        };
+                        unsafe { list.get().rebuild(view.domain) };
                     }
                     barrier.wait();
                     lap(&mut local.neighbor);
                 }
                 unsafe {
                     let l = list.get();
-                    let (a, b) = l.scratch.pair_ranges[tid];
-                    pair_pass(&view, l, a, b);
+                    let (a, m, b) = l.scratch.pair_ranges[tid];
+                    let (mut li, mut lb) = live.unwrap_or((a, m));
+                    // A pair whose gap at the build exceeds twice the displacement bound cannot
+                    // touch yet; its slot stays inactive, exactly as a full pass would leave it.
+                    let reach = 2.0 * bound + 1e-9;
+                    let gap = &l.scratch.gap;
+                    while li < m && gap[li] <= reach {
+                        li += 1;
+                    }
+                    while lb < b && gap[lb] <= reach {
+                        lb += 1;
+                    }
+                    live = Some((li, lb));
+                    pair_pass::<L, false>(&view, l, a, li);
+                    pair_pass::<L, true>(&view, l, m, lb);
                 }
                 lap(&mut local.forces);
                 barrier.wait();
@@ -392,11 +429,11 @@ impl<L: ContactLaw> Simulation<L> {
                 work(0)
             })
         };
-        drop(view);
-        let l = list.into_inner();
-        l.times.forces += local.forces;
-        l.times.integrate += local.integrate;
-        l.times.wait += local.wait;
+        drop(list);
+        let core = &mut self.core;
+        core.times.forces += local.forces;
+        core.times.integrate += local.integrate;
+        core.times.wait += local.wait;
         core.moved_bound = bound;
         for _ in 0..steps {
             core.time += core.dt;
@@ -405,8 +442,10 @@ impl<L: ContactLaw> Simulation<L> {
     }
 }
 
-/// The pair list and everything that changes with it.
+/// The pair list, the particles it indexes, and everything that changes with them.
 struct ListState<'a> {
+    particles: &'a mut Particles,
+    id: &'a mut Vec<u32>,
     pairs: &'a mut PairList,
     xi: &'a mut Vec<Vec3>,
     active: &'a mut Vec<bool>,
@@ -414,42 +453,118 @@ struct ListState<'a> {
     builder: &'a mut NeighborBuilder,
     scratch: &'a mut Scratch,
     times: &'a mut StageTimes,
-    motion: &'a [crate::state::Motion],
+}
+
+fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
+    scratch.clear();
+    scratch.extend(order.iter().map(|&o| v[o as usize]));
+    std::mem::swap(v, scratch);
 }
 
 impl ListState<'_> {
-    /// Rebuilds the pair list at positions `x`, carries every pair's history over, and
-    /// re-balances the particle and pair ranges of the threads.
-    fn rebuild(&mut self, domain: &Domain, x: &[Vec3], radius: &[f64], inv_mass: &[f64]) {
+    /// Re-orders the particles by cell, rebuilds the pair list, carries every contact's history
+    /// over (matched by original ids), and re-balances the threads' ranges.
+    fn rebuild(&mut self, domain: &Domain) {
         let t0 = Instant::now();
         let s = &mut *self.scratch;
-        std::mem::swap(&mut s.old_p, &mut self.pairs.p);
-        std::mem::swap(&mut s.old_i, &mut self.pairs.i);
+        // History of the contacts, by original ids.
+        s.old_keys.clear();
+        for k in 0..self.pairs.p.len() {
+            if self.active[k] {
+                let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+                s.old_keys.push((key(p, i), k as u32));
+            }
+        }
+        s.old_keys.sort_unstable();
         std::mem::swap(&mut s.old_xi, self.xi);
-        std::mem::swap(&mut s.old_active, self.active);
-        let motion = self.motion;
+        // Memory order by cell.
+        let pt = &mut *self.particles;
+        self.builder.order(domain, &pt.x, self.id, &mut s.order);
+        for v in [&mut pt.x, &mut pt.v, &mut pt.w, &mut pt.f, &mut pt.t] {
+            permute(v, &s.order, &mut s.vec3);
+        }
+        for v in [&mut pt.radius, &mut pt.inv_mass, &mut pt.inv_inertia] {
+            permute(v, &s.order, &mut s.real);
+        }
+        permute(&mut pt.motion, &s.order, &mut s.motion);
+        permute(self.id, &s.order, &mut s.index);
+        let motion = &pt.motion;
         // Wall–wall pairs never interact (neighbouring wall spheres overlap by round-off).
-        self.builder.build(self.pairs, domain, x, radius, |a, b| {
+        self.builder.build(self.pairs, domain, &pt.x, &pt.radius, self.id, |a, b| {
             motion[a] == Motion::Free || motion[b] == Motion::Free
         });
-        carry_history(&s.old_p, &s.old_i, &s.old_xi, self.pairs, self.xi);
-        carry_history(&s.old_p, &s.old_i, &s.old_active, self.pairs, self.active);
-        self.out.resize(self.pairs.p.len(), PairForce::default());
+        let n_pairs = self.pairs.p.len();
+        // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
-        let adj = &self.pairs.adj_start;
+        let owner = &self.pairs.owner_start;
+        let inv_mass = &pt.inv_mass;
         balanced_ranges(
-            inv_mass.len(),
+            pt.len(),
             threads,
-            |a| {
-                if inv_mass[a] > 0.0 {
-                    8 + (adj[a + 1] - adj[a]) as u64
-                } else {
-                    2
-                }
-            },
+            |a| (if inv_mass[a] > 0.0 { 8 } else { 2 }) + 2 * (owner[a + 1] - owner[a]) as u64,
             &mut s.particle_ranges,
         );
-        balanced_ranges(self.pairs.p.len(), threads, |_| 1, &mut s.pair_ranges);
+        // Within a share, interior pairs (no periodic image needed until the next build) come
+        // first, then the others; each part sorted by gap, so that a step visits only the
+        // prefix of pairs whose gap the particles can have closed (see `live`).
+        let skin = self.builder.skin;
+        let interior = |a: usize| {
+            (0..3).all(|k| {
+                !domain.periodic[k]
+                    || (pt.x[a][k] >= domain.lo[k] + skin && pt.x[a][k] < domain.hi[k] - skin)
+            })
+        };
+        s.pair_keys.clear();
+        for k in 0..n_pairs {
+            let (p, i) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
+            let direct = pt.x[p] - pt.x[i];
+            let r = domain.min_image(direct);
+            let cut = pt.radius[p] + pt.radius[i] + skin;
+            let plain = interior(p)
+                && interior(i)
+                && r == direct
+                && (0..3).all(|k| !domain.periodic[k] || cut + skin < 0.5 * domain.lengths()[k]);
+            s.pair_keys.push((!plain, r.norm() - (pt.radius[p] + pt.radius[i]), k as u32));
+        }
+        s.pair_ranges.clear();
+        for &(a, b) in &s.particle_ranges {
+            let (pa, pb) = (owner[a] as usize, owner[b] as usize);
+            let part = &mut s.pair_keys[pa..pb];
+            part.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+            let m = pa + part.iter().take_while(|e| !e.0).count();
+            s.pair_ranges.push((pa, m, pb));
+        }
+        s.gap.clear();
+        s.gap.extend(s.pair_keys.iter().map(|e| e.1));
+        s.index.clear();
+        s.index.extend(s.pair_keys.iter().map(|e| self.pairs.p[e.2 as usize]));
+        std::mem::swap(&mut self.pairs.p, &mut s.index);
+        s.index.clear();
+        s.index.extend(s.pair_keys.iter().map(|e| self.pairs.i[e.2 as usize]));
+        std::mem::swap(&mut self.pairs.i, &mut s.index);
+        self.pairs.index(pt.len(), self.id, &mut s.fill);
+        self.xi.clear();
+        self.xi.resize(n_pairs, Vec3::zeros());
+        self.active.clear();
+        self.active.resize(n_pairs, false);
+        self.out.resize(n_pairs, PairForce::default());
+        if !s.old_keys.is_empty() {
+            for k in 0..n_pairs {
+                let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+                // A contact the particles have just left would be closed by the coming force
+                // pass; close it here, since that pass may skip pairs with a positive gap.
+                let (pm, im) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
+                let sum = pt.radius[pm] + pt.radius[im];
+                let touching = domain.min_image(pt.x[pm] - pt.x[im]).norm_squared() < sum * sum;
+                if !touching {
+                    continue;
+                }
+                if let Ok(o) = s.old_keys.binary_search_by_key(&key(p, i), |e| e.0) {
+                    self.xi[k] = s.old_xi[s.old_keys[o].1 as usize];
+                    self.active[k] = true;
+                }
+            }
+        }
         self.times.neighbor += t0.elapsed().as_nanos() as u64;
         self.times.rebuilds += 1;
     }
@@ -470,55 +585,55 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     kick_end: bool,
     drift: bool,
 ) -> f64 {
-    let (x, v, w, f, t) = (view.x.get(), view.v.get(), view.w.get(), view.f.get(), view.t.get());
+    let pt = view.particles.get();
     let dt = view.dt;
     let mut vmax2: f64 = 0.0;
     // Each particle's values are loaded once into locals and stored once: a store followed by
     // an overlapping wider load of the same vector stalls store forwarding.
     for p in a..b {
-        let im = view.inv_mass[p];
+        let im = pt.inv_mass[p];
         if im > 0.0 {
             let (fp, tp) = if kick_end {
                 let g = gather(p, l.pairs, l.active, l.out);
-                f[p] = g.0;
-                t[p] = g.1;
+                pt.f[p] = g.0;
+                pt.t[p] = g.1;
                 g
             } else {
-                (f[p], t[p])
+                (pt.f[p], pt.t[p])
             };
             // Half kick v += (F/m + g)·dt/2, ω += T/I·dt/2, in MercuryDPM's order of operations
             // (BaseParticle::integrateBeforeForceComputation); the closing kick of one step and
             // the opening kick of the next add the same increment twice.
             let acc = if GRAV { fp * im + view.gravity } else { fp * im };
             let dv = acc * 0.5 * dt;
-            let mut vp = v[p];
+            let mut vp = pt.v[p];
             if kick_end {
                 vp += dv;
             }
             if drift {
                 vp += dv;
-                let mut xp = x[p] + vp * dt;
+                let mut xp = pt.x[p] + vp * dt;
                 view.domain.wrap(&mut xp);
-                x[p] = xp;
+                pt.x[p] = xp;
                 vmax2 = vmax2.max(vp.norm_squared());
             }
-            v[p] = vp;
+            pt.v[p] = vp;
             if ROT {
-                let dw = tp * view.inv_inertia[p] * 0.5 * dt;
-                let mut wp = w[p];
+                let dw = tp * pt.inv_inertia[p] * 0.5 * dt;
+                let mut wp = pt.w[p];
                 if kick_end {
                     wp += dw;
                 }
                 if drift {
                     wp += dw;
                 }
-                w[p] = wp;
+                pt.w[p] = wp;
             }
         } else if drift {
-            let vp = v[p];
-            let mut xp = x[p] + vp * dt;
+            let vp = pt.v[p];
+            let mut xp = pt.x[p] + vp * dt;
             view.domain.wrap(&mut xp);
-            x[p] = xp;
+            pt.x[p] = xp;
             vmax2 = vmax2.max(vp.norm_squared());
         }
     }
@@ -547,24 +662,27 @@ fn gather(a: usize, pairs: &PairList, active: &[bool], out: &[PairForce]) -> (Ve
     (f, t)
 }
 
-/// Pair pass over pairs `a..b`.
+/// Pair pass over pairs `a..b`; `PERIODIC` false for interior pairs, whose direct separation
+/// is their minimum image.
 ///
 /// # Safety
 /// Writes the slots of pairs `a..b` only; reads particles, which no one writes in this phase.
 #[inline(never)]
-unsafe fn pair_pass<L: ContactLaw>(view: &StepView<'_, L>, l: &mut ListState<'_>, a: usize, b: usize) {
-    let (x, v, w) = (view.x.get(), view.v.get(), view.w.get());
+unsafe fn pair_pass<L: ContactLaw, const PERIODIC: bool>(
+    view: &StepView<'_, L>,
+    l: &mut ListState<'_>,
+    a: usize,
+    b: usize,
+) {
+    let pt = view.particles.get();
     for k in a..b {
-        pair_force(
+        pair_force::<L, PERIODIC>(
             view.law,
             view.domain,
             view.dt,
             k,
             l.pairs,
-            x,
-            v,
-            w,
-            view.radius,
+            pt,
             &mut l.xi[k],
             &mut l.active[k],
             &mut l.out[k],
@@ -575,23 +693,21 @@ unsafe fn pair_pass<L: ContactLaw>(view: &StepView<'_, L>, l: &mut ListState<'_>
 /// Force of pair `k` into its slot; a pair that is not touching forgets its history.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pair_force<L: ContactLaw>(
+fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     law: &L,
     domain: &Domain,
     dt: f64,
     k: usize,
     pairs: &PairList,
-    x: &[Vec3],
-    v: &[Vec3],
-    w: &[Vec3],
-    radius: &[f64],
+    pt: &Particles,
     xi: &mut Vec3,
     active: &mut bool,
     out: &mut PairForce,
 ) {
     let (p, i) = (pairs.p[k] as usize, pairs.i[k] as usize);
-    let r = domain.min_image(x[p] - x[i]);
-    let sum = radius[p] + radius[i];
+    let direct = pt.x[p] - pt.x[i];
+    let r = if PERIODIC { domain.min_image(direct) } else { direct };
+    let sum = pt.radius[p] + pt.radius[i];
     if r.norm_squared() >= sum * sum {
         if *active {
             *active = false;
@@ -601,12 +717,12 @@ fn pair_force<L: ContactLaw>(
     }
     let input = PairInput {
         r,
-        rad_p: radius[p],
-        rad_i: radius[i],
-        v_p: v[p],
-        v_i: v[i],
-        w_p: w[p],
-        w_i: w[i],
+        rad_p: pt.radius[p],
+        rad_i: pt.radius[i],
+        v_p: pt.v[p],
+        v_i: pt.v[i],
+        w_p: pt.w[p],
+        w_i: pt.w[i],
     };
     if let Some(kin) = input.kinematics() {
         *out = law.evaluate(&kin, xi, dt);

@@ -16,7 +16,8 @@ use std::path::Path;
 
 use super::{fmt_f64, parse_numbers, FormatError};
 use crate::domain::Domain;
-use crate::sim::Core;
+use crate::contact::PairInput;
+use crate::sim::Snapshot;
 use crate::state::Motion;
 use crate::Vec3;
 
@@ -27,8 +28,8 @@ fn push_vec(s: &mut String, v: &Vec3) {
     }
 }
 
-/// Text of the `.data` save of the current state.
-pub fn data_text(core: &Core) -> String {
+/// Text of the `.data` save of a state.
+pub fn data_text(core: &Snapshot) -> String {
     let p = &core.particles;
     let mut s = String::with_capacity(200 * p.len() + 100);
     s.push_str(&p.len().to_string());
@@ -61,9 +62,9 @@ struct Side {
     t: Vec3,
 }
 
-/// Text of the `.fstat` save of the current state (the contacts of the last force evaluation,
-/// which belong to the current positions).
-pub fn fstat_text(core: &Core) -> String {
+/// Text of the `.fstat` save of a state (the contacts of the last force evaluation, which
+/// belong to its positions).
+pub fn fstat_text(core: &Snapshot) -> String {
     let p = &core.particles;
     let rmin = p.radius.iter().cloned().fold(f64::INFINITY, f64::min);
     let rmax = p.radius.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
@@ -78,15 +79,22 @@ pub fn fstat_text(core: &Core) -> String {
     s.push(' ');
     fmt_f64(&mut s, rmax);
     s.push_str(" 0 0 0 0\n");
-    for k in 0..core.pairs.p.len() {
-        if !core.active[k] {
-            continue;
-        }
-        let Some(g) = core.pair_geometry(k) else {
+    for contact in &core.contacts {
+        let (pp, ii) = (contact.p as usize, contact.i as usize);
+        // n, δ and the contact point exactly as the force pass computed them.
+        let Some(g) = (PairInput {
+            r: core.domain.min_image(p.x[pp] - p.x[ii]),
+            rad_p: p.radius[pp],
+            rad_i: p.radius[ii],
+            v_p: Vec3::zeros(),
+            v_i: Vec3::zeros(),
+            w_p: Vec3::zeros(),
+            w_i: Vec3::zeros(),
+        })
+        .kinematics() else {
             continue;
         };
-        let (pp, ii) = (core.pairs.p[k] as usize, core.pairs.i[k] as usize);
-        let out = &core.out[k];
+        let out = &contact.force;
         let ft_vec = out.f - out.fn_signed * g.n;
         let ft = ft_vec.norm();
         let t = if ft > 0.0 { ft_vec / ft } else { Vec3::zeros() };
@@ -102,7 +110,7 @@ pub fn fstat_text(core: &Core) -> String {
             fmt_f64(&mut s, core.time);
             s.push_str(&format!(" {} {}", side.i, side.j));
             push_vec(&mut s, &c);
-            for v in [g.delta, -core.xi[k].norm(), out.fn_signed, ft] {
+            for v in [g.delta, -contact.xi.norm(), out.fn_signed, ft] {
                 s.push(' ');
                 fmt_f64(&mut s, v);
             }
