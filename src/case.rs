@@ -251,7 +251,11 @@ impl Case {
             }
         };
         if self.name.is_empty() || self.name.contains('/') {
-            return Err(err("", "name", format!("must be a plain file name, got {:?}", self.name)));
+            return Err(err(
+                "",
+                "name",
+                format!("must be a plain file name, got {:?}", self.name),
+            ));
         }
         if self.run.save_every == 0 {
             return Err(err("run", "save_every", "must be > 0, got 0".into()));
@@ -278,11 +282,14 @@ impl Case {
         positive("neighbor", "skin", self.neighbor.skin)?;
         non_negative("neighbor", "cell", self.neighbor.cell)?;
         for k in 0..3 {
-            if !(self.domain.hi[k] > self.domain.lo[k]) {
+            if self.domain.hi[k] <= self.domain.lo[k] || self.domain.hi[k].is_nan() {
                 return Err(err(
                     "domain",
                     "hi",
-                    format!("must exceed lo on every axis, got lo {:?} hi {:?}", self.domain.lo, self.domain.hi),
+                    format!(
+                        "must exceed lo on every axis, got lo {:?} hi {:?}",
+                        self.domain.lo, self.domain.hi
+                    ),
                 ));
             }
         }
@@ -300,7 +307,10 @@ impl Case {
             return Err(err(
                 "contact",
                 "gamman",
-                format!("overdamped: gamman = {} leaves no oscillation (kn/meff < (gamman/2meff)^2)", c.gamman),
+                format!(
+                    "overdamped: gamman = {} leaves no oscillation (kn/meff < (gamman/2meff)^2)",
+                    c.gamman
+                ),
             ));
         }
         match &self.scene {
@@ -316,10 +326,18 @@ impl Case {
                     return Err(err("scene", "free", "must be > 0, got 0".into()));
                 }
                 if *wall_rows == 0 || *wall_per_row == 0 {
-                    return Err(err("scene", "wall_rows", "walls need rows and spheres per row".into()));
+                    return Err(err(
+                        "scene",
+                        "wall_rows",
+                        "walls need rows and spheres per row".into(),
+                    ));
                 }
-                if !(top_z > bottom_z) {
-                    return Err(err("scene", "top_z", format!("must exceed bottom_z, got {top_z} <= {bottom_z}")));
+                if top_z <= bottom_z || top_z.is_nan() {
+                    return Err(err(
+                        "scene",
+                        "top_z",
+                        format!("must exceed bottom_z, got {top_z} <= {bottom_z}"),
+                    ));
                 }
             }
             Scene::Spheres { sphere } => {
@@ -390,7 +408,13 @@ fn locate(text: &str, table: &str, key: &str) -> usize {
     for (n, line) in text.lines().enumerate() {
         let l = line.trim();
         if let Some(rest) = l.strip_prefix('[') {
-            current = rest.trim_start_matches('[').split(']').next().unwrap_or("").trim().to_string();
+            current = rest
+                .trim_start_matches('[')
+                .split(']')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_string();
             if current == table {
                 header = n + 1;
             }
@@ -429,7 +453,10 @@ mod tests {
         let bad = CASE.replace("kn = 2e5", "kn = -3.0");
         let e = Case::parse(&bad, "bad.toml").unwrap_err();
         let line = bad.lines().position(|l| l.starts_with("kn =")).unwrap() + 1;
-        assert_eq!(e.to_string(), format!("bad.toml:{line}: contact.kn: must be > 0, got -3"));
+        assert_eq!(
+            e.to_string(),
+            format!("bad.toml:{line}: contact.kn: must be > 0, got -3")
+        );
     }
 
     #[test]
@@ -443,7 +470,10 @@ mod tests {
 
     #[test]
     fn dt_must_be_given_exactly_once() {
-        let bad = CASE.replace("dt = 7.192545031528827e-05", "dt = 1e-5\nsteps_per_collision = 50.0");
+        let bad = CASE.replace(
+            "dt = 7.192545031528827e-05",
+            "dt = 1e-5\nsteps_per_collision = 50.0",
+        );
         let e = Case::parse(&bad, "bad.toml").unwrap_err();
         assert_eq!(e.field, "run.dt");
     }

@@ -44,7 +44,8 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
     }
-    crate::io::atomic::write(path, &b).with_context(|| format!("{}: cannot write checkpoint", path.display()))
+    crate::io::atomic::write(path, &b)
+        .with_context(|| format!("{}: cannot write checkpoint", path.display()))
 }
 
 struct Reader<'a> {
@@ -62,10 +63,14 @@ impl Reader<'_> {
         Ok(&self.b[self.at - n..self.at])
     }
     fn u64(&mut self) -> anyhow::Result<u64> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn u32(&mut self) -> anyhow::Result<u32> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
     fn f64(&mut self) -> anyhow::Result<f64> {
         Ok(f64::from_bits(self.u64()?))
@@ -77,7 +82,8 @@ impl Reader<'_> {
 
 /// Restores a checkpoint into `core` (built from the same case); returns the step it holds.
 pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
     let mut r = Reader {
         b: &bytes,
         at: 0,
@@ -89,18 +95,29 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
     let tag_len = r.u64()? as usize;
     let file_tag = String::from_utf8_lossy(r.take(tag_len)?).to_string();
     if file_tag != tag {
-        bail!("{}: checkpoint of case {file_tag:?}, not {tag:?}", path.display());
+        bail!(
+            "{}: checkpoint of case {file_tag:?}, not {tag:?}",
+            path.display()
+        );
     }
     let mut snap = core.snapshot();
     snap.step = r.u64()?;
     snap.time = r.f64()?;
     let dt = r.f64()?;
     if dt.to_bits() != core.dt.to_bits() {
-        bail!("{}: checkpoint dt {dt} differs from the case's {}", path.display(), core.dt);
+        bail!(
+            "{}: checkpoint dt {dt} differs from the case's {}",
+            path.display(),
+            core.dt
+        );
     }
     let n = r.u64()? as usize;
     if n != core.particles.len() {
-        bail!("{}: checkpoint has {n} particles, the case {}", path.display(), core.particles.len());
+        bail!(
+            "{}: checkpoint has {n} particles, the case {}",
+            path.display(),
+            core.particles.len()
+        );
     }
     let p = &mut snap.particles;
     for a in 0..n {
@@ -132,7 +149,11 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
         });
     }
     if r.at != bytes.len() {
-        bail!("{}: {} trailing bytes after the checkpoint", path.display(), bytes.len() - r.at);
+        bail!(
+            "{}: {} trailing bytes after the checkpoint",
+            path.display(),
+            bytes.len() - r.at
+        );
     }
     core.restore(&snap);
     Ok(core.step)

@@ -60,8 +60,16 @@ impl Domain {
         // x − (up − down) with up, down ∈ {0, L} chosen without branches; x − 0 = x bit for bit.
         for k in 0..3 {
             if self.periodic[k] {
-                let up = if x[k] >= self.hi[k] { self.period[k] } else { 0.0 };
-                let down = if x[k] < self.lo[k] { self.period[k] } else { 0.0 };
+                let up = if x[k] >= self.hi[k] {
+                    self.period[k]
+                } else {
+                    0.0
+                };
+                let down = if x[k] < self.lo[k] {
+                    self.period[k]
+                } else {
+                    0.0
+                };
                 x[k] -= up - down;
             }
         }
@@ -79,7 +87,11 @@ mod tests {
     use super::*;
 
     fn shear_box() -> Domain {
-        Domain::new(Vec3::zeros(), Vec3::new(20.0, 10.0, 22.0), [true, true, false])
+        Domain::new(
+            Vec3::zeros(),
+            Vec3::new(20.0, 10.0, 22.0),
+            [true, true, false],
+        )
     }
 
     #[test]

@@ -49,7 +49,13 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
     };
     // Model only what the case needs: without friction no tangential history, torque or spin.
     match (c.mu > 0.0, c.clip_normal) {
-        (true, false) => Box::new(Simulation::new(Composed { normal, tangential: friction }, core)),
+        (true, false) => Box::new(Simulation::new(
+            Composed {
+                normal,
+                tangential: friction,
+            },
+            core,
+        )),
         (true, true) => Box::new(Simulation::new(
             Composed {
                 normal: Clipped(normal),

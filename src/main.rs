@@ -11,7 +11,11 @@ use verdem::run::{self, RunOptions};
 use verdem::{checkpoint, hash, scene};
 
 #[derive(Parser)]
-#[command(name = "verdem", version, about = "Deterministic DEM solver, verification harness and benchmark suite")]
+#[command(
+    name = "verdem",
+    version,
+    about = "Deterministic DEM solver, verification harness and benchmark suite"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -116,7 +120,11 @@ fn real_main() -> anyhow::Result<()> {
             let tag = format!("{}:{}", case.name, engine.core().particles.len());
             if let Some(ck) = &resume {
                 checkpoint::read(ck, engine.core_mut(), &tag)?;
-                println!("resumed at step {} (t = {})", engine.core().step, engine.core().time);
+                println!(
+                    "resumed at step {} (t = {})",
+                    engine.core().step,
+                    engine.core().time
+                );
             }
             let opts = RunOptions {
                 end_step: steps.unwrap_or(case.run.steps),
@@ -166,7 +174,8 @@ fn real_main() -> anyhow::Result<()> {
                 s.rate()
             );
             let p = opts.out_dir.join(format!("{}.summary.toml", case.name));
-            verdem::io::atomic::write(&p, summary.as_bytes()).with_context(|| p.display().to_string())?;
+            verdem::io::atomic::write(&p, summary.as_bytes())
+                .with_context(|| p.display().to_string())?;
         }
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;

@@ -134,7 +134,10 @@ impl NeighborBuilder {
                 for a in 0..n {
                     partners.clear();
                     grid.for_each_neighbour(grid.coords(domain, &x[a]), |nc| {
-                        let (s, e) = (self.cell_start[nc] as usize, self.cell_start[nc + 1] as usize);
+                        let (s, e) = (
+                            self.cell_start[nc] as usize,
+                            self.cell_start[nc + 1] as usize,
+                        );
                         for b in s.max(a + 1)..e {
                             if accept(a, b) {
                                 partners.push(b as u32);
@@ -303,7 +306,14 @@ mod tests {
         let mut cells = PairList::default();
         b.build(&mut cells, &domain, &xs, &r, &ids, |_, _| true);
         let mut all = PairList::default();
-        NeighborBuilder::new(0.3, 0.0, 0.5, Search::AllPairs).build(&mut all, &domain, &x, &r, &id, |_, _| true);
+        NeighborBuilder::new(0.3, 0.0, 0.5, Search::AllPairs).build(
+            &mut all,
+            &domain,
+            &x,
+            &r,
+            &id,
+            |_, _| true,
+        );
         assert_eq!(*cells.owner_start.last().unwrap() as usize, cells.p.len());
         assert!(!cells.p.is_empty());
         assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));

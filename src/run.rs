@@ -64,7 +64,11 @@ pub fn checkpoint_path(dir: &Path, name: &str) -> PathBuf {
 }
 
 /// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists.
-pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow::Result<RunSummary> {
+pub fn run(
+    engine: &mut dyn Engine,
+    opts: &RunOptions,
+    resumed: bool,
+) -> anyhow::Result<RunSummary> {
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
@@ -79,14 +83,17 @@ pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow:
     loop {
         let core = engine.core();
         let step = core.step;
-        if opts.write_saves && step % opts.save_every == 0 && !(first && resumed) {
+        if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
             if !core.forces_ready {
                 engine.advance(0);
             }
             write_save(engine, opts, &diag)?;
             saves += 1;
         }
-        if opts.checkpoint_every > 0 && step % opts.checkpoint_every == 0 && step != start_step {
+        if opts.checkpoint_every > 0
+            && step.is_multiple_of(opts.checkpoint_every)
+            && step != start_step
+        {
             crate::checkpoint::write(
                 &checkpoint_path(&opts.out_dir, &opts.name),
                 &engine.core().snapshot(),
@@ -102,8 +109,8 @@ pub fn run(engine: &mut dyn Engine, opts: &RunOptions, resumed: bool) -> anyhow:
         if opts.write_saves {
             next = next.min((step / opts.save_every + 1) * opts.save_every);
         }
-        if opts.checkpoint_every > 0 {
-            next = next.min((step / opts.checkpoint_every + 1) * opts.checkpoint_every);
+        if let Some(k) = step.checked_div(opts.checkpoint_every) {
+            next = next.min((k + 1) * opts.checkpoint_every);
         }
         engine.advance(next - step);
         if let Some(b) = &bar {
@@ -152,7 +159,8 @@ fn prepare_diagnostics(path: &Path, step: u64, resumed: bool) -> anyhow::Result<
             }
         }
     }
-    atomic::write(path, text.as_bytes()).with_context(|| format!("{}: cannot write", path.display()))
+    atomic::write(path, text.as_bytes())
+        .with_context(|| format!("{}: cannot write", path.display()))
 }
 
 fn progress_bar(opts: &RunOptions, start: u64) -> Option<indicatif::ProgressBar> {

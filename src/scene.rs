@@ -48,7 +48,10 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
             top_vx,
         } => {
             let walls = [
-                (bumpy_wall(*wall_rows, *wall_per_row, d, *bottom_z), *bottom_vx),
+                (
+                    bumpy_wall(*wall_rows, *wall_per_row, d, *bottom_z),
+                    *bottom_vx,
+                ),
                 (bumpy_wall(*wall_rows, *wall_per_row, d, *top_z), *top_vx),
             ];
             let n_wall = 2 * wall_rows * wall_per_row;
@@ -84,7 +87,14 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                                     );
                                 }
                             }
-                            particles.push(loaded.x[a], v, Vec3::zeros(), loaded.radius[a], rho, Motion::Prescribed(g));
+                            particles.push(
+                                loaded.x[a],
+                                v,
+                                Vec3::zeros(),
+                                loaded.radius[a],
+                                rho,
+                                Motion::Prescribed(g),
+                            );
                         }
                         None => particles.push(
                             loaded.x[a],
@@ -99,7 +109,14 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
             } else {
                 for (g, (pos, vx)) in walls.iter().enumerate() {
                     for x in pos {
-                        particles.push(*x, Vec3::new(*vx, 0.0, 0.0), Vec3::zeros(), 0.5 * d, rho, Motion::Prescribed(g as u8));
+                        particles.push(
+                            *x,
+                            Vec3::new(*vx, 0.0, 0.0),
+                            Vec3::zeros(),
+                            0.5 * d,
+                            rho,
+                            Motion::Prescribed(g as u8),
+                        );
                     }
                 }
                 let wall_x: Vec<Vec3> = walls.iter().flat_map(|w| w.0.iter().copied()).collect();
@@ -111,8 +128,19 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
         }
         SceneSpec::Spheres { sphere } => {
             for (k, s) in sphere.iter().enumerate() {
-                let motion = if s.fixed { Motion::Prescribed(k.min(255) as u8) } else { Motion::Free };
-                particles.push(Vec3::from(s.x), Vec3::from(s.v), Vec3::from(s.w), 0.5 * d, rho, motion);
+                let motion = if s.fixed {
+                    Motion::Prescribed(k.min(255) as u8)
+                } else {
+                    Motion::Free
+                };
+                particles.push(
+                    Vec3::from(s.x),
+                    Vec3::from(s.v),
+                    Vec3::from(s.w),
+                    0.5 * d,
+                    rho,
+                    motion,
+                );
             }
         }
     }
@@ -137,7 +165,8 @@ struct Loaded {
 
 /// Reads an official initial file or a MercuryCG `.data` file, checking its box.
 fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
     let file = path.display().to_string();
     if official::looks_official(&text) {
         let f = official::read(path, &text)?;
@@ -195,7 +224,10 @@ pub fn random_fill(
     let (z0, z1) = (z_range.0 + 0.5 * spacing, z_range.1 - 0.5 * spacing);
     let nx = (l.x / spacing).floor() as usize;
     let ny = (l.y / spacing).floor() as usize;
-    let nz = ((z1 - z0) / spacing).floor() as usize + 1;
+    // As few layers as hold n spheres, spread over the whole height: the most room to move.
+    let nz_max = ((z1 - z0) / spacing).floor() as usize + 1;
+    let nz = n.div_ceil((nx * ny).max(1)).clamp(2, nz_max.max(2));
+    let dz = (z1 - z0) / (nz - 1) as f64;
     let mut sites = Vec::with_capacity(nx * ny * nz);
     for k in 0..nz {
         for j in 0..ny {
@@ -203,21 +235,27 @@ pub fn random_fill(
                 let x = Vec3::new(
                     domain.lo.x + (i as f64 + 0.5) * l.x / nx as f64,
                     domain.lo.y + (j as f64 + 0.5) * l.y / ny as f64,
-                    z0 + k as f64 * spacing,
+                    z0 + k as f64 * dz,
                 );
-                if fixed.iter().all(|f| domain.min_image(x - f).norm() >= spacing) {
+                if fixed
+                    .iter()
+                    .all(|f| domain.min_image(x - f).norm() >= spacing)
+                {
                     sites.push(x);
                 }
             }
         }
     }
     if sites.len() < n {
-        bail!("cannot fit {n} spheres of diameter {d} between the walls (room for {} on a lattice)", sites.len());
+        bail!(
+            "cannot fit {n} spheres of diameter {d} between the walls (room for {} on a lattice)",
+            sites.len()
+        );
     }
     sites.shuffle(&mut rng);
     sites.truncate(n);
     let mut grid = HardSphereGrid::new(domain, d, fixed, &sites);
-    let sweeps = 200;
+    let sweeps = 400;
     let step = 0.3 * d;
     for _ in 0..sweeps {
         for a in 0..n {

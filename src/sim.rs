@@ -190,7 +190,10 @@ impl Core {
         self.rebuild();
         let mut slot = std::collections::HashMap::new();
         for k in 0..self.pairs.p.len() {
-            let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+            let (p, i) = (
+                self.id[self.pairs.p[k] as usize],
+                self.id[self.pairs.i[k] as usize],
+            );
             slot.insert(key(p, i), k);
         }
         for c in contacts {
@@ -316,7 +319,17 @@ impl<L: ContactLaw> Simulation<L> {
         let c = &mut self.core;
         let pt = &mut c.particles;
         for k in 0..c.pairs.p.len() {
-            pair_force::<L, true>(&self.law, &c.domain, c.dt, k, &c.pairs, pt, &mut c.xi[k], &mut c.active[k], &mut c.out[k]);
+            pair_force::<L, true>(
+                &self.law,
+                &c.domain,
+                c.dt,
+                k,
+                &c.pairs,
+                pt,
+                &mut c.xi[k],
+                &mut c.active[k],
+                &mut c.out[k],
+            );
         }
         for a in 0..pt.len() {
             let (f, t) = gather(a, &c.pairs, &c.active, &c.out);
@@ -429,7 +442,6 @@ impl<L: ContactLaw> Simulation<L> {
                 work(0)
             })
         };
-        drop(list);
         let core = &mut self.core;
         core.times.forces += local.forces;
         core.times.integrate += local.integrate;
@@ -471,7 +483,10 @@ impl ListState<'_> {
         s.old_keys.clear();
         for k in 0..self.pairs.p.len() {
             if self.active[k] {
-                let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+                let (p, i) = (
+                    self.id[self.pairs.p[k] as usize],
+                    self.id[self.pairs.i[k] as usize],
+                );
                 s.old_keys.push((key(p, i), k as u32));
             }
         }
@@ -490,9 +505,10 @@ impl ListState<'_> {
         permute(self.id, &s.order, &mut s.index);
         let motion = &pt.motion;
         // Wall–wall pairs never interact (neighbouring wall spheres overlap by round-off).
-        self.builder.build(self.pairs, domain, &pt.x, &pt.radius, self.id, |a, b| {
-            motion[a] == Motion::Free || motion[b] == Motion::Free
-        });
+        self.builder
+            .build(self.pairs, domain, &pt.x, &pt.radius, self.id, |a, b| {
+                motion[a] == Motion::Free || motion[b] == Motion::Free
+            });
         let n_pairs = self.pairs.p.len();
         // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
@@ -524,23 +540,28 @@ impl ListState<'_> {
                 && interior(i)
                 && r == direct
                 && (0..3).all(|k| !domain.periodic[k] || cut + skin < 0.5 * domain.lengths()[k]);
-            s.pair_keys.push((!plain, r.norm() - (pt.radius[p] + pt.radius[i]), k as u32));
+            s.pair_keys
+                .push((!plain, r.norm() - (pt.radius[p] + pt.radius[i]), k as u32));
         }
         s.pair_ranges.clear();
         for &(a, b) in &s.particle_ranges {
             let (pa, pb) = (owner[a] as usize, owner[b] as usize);
             let part = &mut s.pair_keys[pa..pb];
-            part.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2)));
+            part.sort_unstable_by(|x, y| {
+                x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2))
+            });
             let m = pa + part.iter().take_while(|e| !e.0).count();
             s.pair_ranges.push((pa, m, pb));
         }
         s.gap.clear();
         s.gap.extend(s.pair_keys.iter().map(|e| e.1));
         s.index.clear();
-        s.index.extend(s.pair_keys.iter().map(|e| self.pairs.p[e.2 as usize]));
+        s.index
+            .extend(s.pair_keys.iter().map(|e| self.pairs.p[e.2 as usize]));
         std::mem::swap(&mut self.pairs.p, &mut s.index);
         s.index.clear();
-        s.index.extend(s.pair_keys.iter().map(|e| self.pairs.i[e.2 as usize]));
+        s.index
+            .extend(s.pair_keys.iter().map(|e| self.pairs.i[e.2 as usize]));
         std::mem::swap(&mut self.pairs.i, &mut s.index);
         self.pairs.index(pt.len(), self.id, &mut s.fill);
         self.xi.clear();
@@ -550,7 +571,10 @@ impl ListState<'_> {
         self.out.resize(n_pairs, PairForce::default());
         if !s.old_keys.is_empty() {
             for k in 0..n_pairs {
-                let (p, i) = (self.id[self.pairs.p[k] as usize], self.id[self.pairs.i[k] as usize]);
+                let (p, i) = (
+                    self.id[self.pairs.p[k] as usize],
+                    self.id[self.pairs.i[k] as usize],
+                );
                 // A contact the particles have just left would be closed by the coming force
                 // pass; close it here, since that pass may skip pairs with a positive gap.
                 let (pm, im) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
@@ -604,7 +628,11 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
             // Half kick v += (F/m + g)·dt/2, ω += T/I·dt/2, in MercuryDPM's order of operations
             // (BaseParticle::integrateBeforeForceComputation); the closing kick of one step and
             // the opening kick of the next add the same increment twice.
-            let acc = if GRAV { fp * im + view.gravity } else { fp * im };
+            let acc = if GRAV {
+                fp * im + view.gravity
+            } else {
+                fp * im
+            };
             let dv = acc * 0.5 * dt;
             let mut vp = pt.v[p];
             if kick_end {
@@ -706,7 +734,11 @@ fn pair_force<L: ContactLaw, const PERIODIC: bool>(
 ) {
     let (p, i) = (pairs.p[k] as usize, pairs.i[k] as usize);
     let direct = pt.x[p] - pt.x[i];
-    let r = if PERIODIC { domain.min_image(direct) } else { direct };
+    let r = if PERIODIC {
+        domain.min_image(direct)
+    } else {
+        direct
+    };
     let sum = pt.radius[p] + pt.radius[i];
     if r.norm_squared() >= sum * sum {
         if *active {

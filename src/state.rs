@@ -56,8 +56,11 @@ impl Particles {
         self.w.push(w);
         self.radius.push(radius);
         self.inv_mass.push(if free { 1.0 / mass } else { 0.0 });
-        self.inv_inertia
-            .push(if free { 1.0 / (0.4 * mass * radius * radius) } else { 0.0 });
+        self.inv_inertia.push(if free {
+            1.0 / (0.4 * mass * radius * radius)
+        } else {
+            0.0
+        });
         self.motion.push(motion);
         self.f.push(Vec3::zeros());
         self.t.push(Vec3::zeros());

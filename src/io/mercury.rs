@@ -15,8 +15,8 @@
 use std::path::Path;
 
 use super::{fmt_f64, parse_numbers, FormatError};
-use crate::domain::Domain;
 use crate::contact::PairInput;
+use crate::domain::Domain;
 use crate::sim::Snapshot;
 use crate::state::Motion;
 use crate::Vec3;
@@ -99,8 +99,18 @@ pub fn fstat_text(core: &Snapshot) -> String {
         let ft = ft_vec.norm();
         let t = if ft > 0.0 { ft_vec / ft } else { Vec3::zeros() };
         let c = p.x[pp] + g.arm_p;
-        let forward = Side { i: pp, j: ii, n: g.n, t };
-        let backward = Side { i: ii, j: pp, n: -g.n, t: -t };
+        let forward = Side {
+            i: pp,
+            j: ii,
+            n: g.n,
+            t,
+        };
+        let backward = Side {
+            i: ii,
+            j: pp,
+            n: -g.n,
+            t: -t,
+        };
         let sides: &[Side] = match (p.motion[pp], p.motion[ii]) {
             (Motion::Free, Motion::Free) => &[forward, backward],
             (Motion::Free, _) => &[forward],
@@ -301,7 +311,13 @@ pub fn read_fstat(path: &Path) -> Result<FstatFile, FormatError> {
 }
 
 /// Checks that a file's box matches the case's within `tol` (files may round it to 10 digits).
-pub fn check_box(file: &str, lo: &Vec3, hi: &Vec3, domain: &Domain, tol: f64) -> Result<(), FormatError> {
+pub fn check_box(
+    file: &str,
+    lo: &Vec3,
+    hi: &Vec3,
+    domain: &Domain,
+    tol: f64,
+) -> Result<(), FormatError> {
     if (lo - domain.lo).amax() > tol || (hi - domain.hi).amax() > tol {
         return Err(FormatError {
             file: file.into(),

@@ -33,12 +33,18 @@ pub fn read(path: &Path, text: &str) -> Result<OfficialFile, FormatError> {
     let head: Vec<&str> = lines.next().unwrap_or("").split_whitespace().collect();
     let names = ["xMin", "xMax", "yMin", "yMax", "zMin", "zMax"];
     if head.len() != 12 || head.iter().step_by(2).zip(names).any(|(a, b)| *a != b) {
-        return Err(err(1, "expected `xMin a xMax b yMin c yMax d zMin e zMax f`".into()));
+        return Err(err(
+            1,
+            "expected `xMin a xMax b yMin c yMax d zMin e zMax f`".into(),
+        ));
     }
     let val = |k: usize| -> Result<f64, FormatError> {
-        head[2 * k + 1]
-            .parse()
-            .map_err(|_| err(1, format!("{}: not a number: {:?}", names[k], head[2 * k + 1])))
+        head[2 * k + 1].parse().map_err(|_| {
+            err(
+                1,
+                format!("{}: not a number: {:?}", names[k], head[2 * k + 1]),
+            )
+        })
     };
     let lo = Vec3::new(val(0)?, val(2)?, val(4)?);
     let hi = Vec3::new(val(1)?, val(3)?, val(5)?);
@@ -64,14 +70,20 @@ pub fn read(path: &Path, text: &str) -> Result<OfficialFile, FormatError> {
         }
         parse_numbers(&file, line_no, line, &mut nums)?;
         if nums.len() != 5 {
-            return Err(err(line_no, format!("expected 5 columns (id x y z radius), got {}", nums.len())));
+            return Err(err(
+                line_no,
+                format!("expected 5 columns (id x y z radius), got {}", nums.len()),
+            ));
         }
         let id = out.x.len() + 1;
         if nums[0] != id as f64 {
             return Err(err(line_no, format!("id: expected {id}, got {}", nums[0])));
         }
         if nums[4] <= 0.0 {
-            return Err(err(line_no, format!("radius: must be > 0, got {}", nums[4])));
+            return Err(err(
+                line_no,
+                format!("radius: must be > 0, got {}", nums[4]),
+            ));
         }
         out.x.push(Vec3::new(nums[1], nums[2], nums[3]));
         out.radius.push(nums[4]);
@@ -79,7 +91,10 @@ pub fn read(path: &Path, text: &str) -> Result<OfficialFile, FormatError> {
     if out.x.len() != n {
         return Err(err(
             text.lines().count(),
-            format!("header announces {n} particles but the file has {}", out.x.len()),
+            format!(
+                "header announces {n} particles but the file has {}",
+                out.x.len()
+            ),
         ));
     }
     Ok(out)
