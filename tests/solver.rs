@@ -103,3 +103,31 @@ fn one_ulp_in_one_velocity_changes_the_hash() {
     snap.particles.v[2000].y = f64::from_bits(snap.particles.v[2000].y.to_bits() + 1);
     assert_ne!(verdem::hash::state_hash(&snap), before);
 }
+
+/// The hash sees a change of summation order: the contact forces of the developed state summed
+/// in reverse order give other bits, and a particle kicked from rest with the two sums gives
+/// states that hash differently.
+#[test]
+fn reordered_force_summation_changes_the_hash() {
+    let case = quick_case();
+    let mut e = engine(
+        &case,
+        Some(&shared("states/mercury_t143.85.data")),
+        Overrides::default(),
+    );
+    e.advance(100);
+    let snap = e.core().snapshot();
+    let terms: Vec<_> = snap.contacts.iter().map(|c| c.force.f).collect();
+    assert!(terms.len() >= 3);
+    let forward = terms.iter().fold(verdem::Vec3::zeros(), |s, f| s + f);
+    let backward = terms.iter().rev().fold(verdem::Vec3::zeros(), |s, f| s + f);
+    assert_ne!(forward, backward, "these sums depend on the order");
+    let a = 2000;
+    let kick = |f: verdem::Vec3| {
+        let mut s = snap.clone();
+        // a particle starting from rest: its velocity is the kick alone
+        s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.core().dt;
+        verdem::hash::state_hash(&s)
+    };
+    assert_ne!(kick(forward), kick(backward));
+}

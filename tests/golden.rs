@@ -1,0 +1,104 @@
+//! Golden snapshots (golden/*.snap, insta): state hashes, diagnostics tables and the first lines
+//! of saves of short runs of every case. A change of physics or of bits shows here as a diff.
+//! Re-bless on purpose only, with `bash ci/bless.sh`, and say why in the commit message.
+
+mod common;
+
+use common::*;
+use verdem::engine::Overrides;
+use verdem::run::{self, RunOptions};
+
+fn golden(name: &str, how: &str, body: String) {
+    insta::with_settings!({
+        snapshot_path => root().join("golden"),
+        prepend_module_to_snapshot => false,
+        description => format!("verdem {}; produced by `bash ci/bless.sh` (tests/golden.rs): {how}", env!("CARGO_PKG_VERSION")),
+        omit_expression => true,
+    }, {
+        insta::assert_snapshot!(name, body);
+    });
+}
+
+/// Runs `steps` steps with a save every `save_every`, on 1 and 2 threads; both must agree.
+fn short_run(
+    init: Option<&std::path::Path>,
+    steps: u64,
+    save_every: u64,
+) -> (String, String, String, String) {
+    let case = quick_case();
+    let mut outputs = Vec::new();
+    for threads in [1, 2] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut e = engine(
+            &case,
+            init,
+            Overrides {
+                threads: Some(threads),
+                ..Overrides::default()
+            },
+        );
+        let opts = RunOptions {
+            end_step: steps,
+            save_every,
+            checkpoint_every: 0,
+            out_dir: dir.path().to_path_buf(),
+            name: "g".into(),
+            tag: "g".into(),
+            progress: false,
+            write_saves: true,
+        };
+        let s = run::run(e.as_mut(), &opts, false).unwrap();
+        let last = steps / save_every;
+        let head = |ext: &str, n: usize| -> String {
+            std::fs::read_to_string(run::save_path(dir.path(), "g", ext, last))
+                .unwrap()
+                .lines()
+                .take(n)
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        let diag = std::fs::read_to_string(run::diagnostics_path(dir.path(), "g")).unwrap();
+        outputs.push((s.hash, diag, head("data", 4), head("fstat", 9)));
+    }
+    assert_eq!(outputs[0], outputs[1], "1 and 2 threads differ");
+    outputs.remove(0)
+}
+
+fn check(tag: &str, init: Option<&std::path::Path>, what: &str) {
+    let (steps, every) = (4000, 1000);
+    let (hash, diag, data, fstat) = short_run(init, steps, every);
+    let how = format!(
+        "cases/shear_flow_quick.toml {what}, {steps} steps, a save every {every}, 1 and 2 threads"
+    );
+    golden(
+        &format!("{tag}_hash"),
+        &how,
+        format!("steps = {steps}\nhash = {hash}\n"),
+    );
+    golden(&format!("{tag}_diagnostics"), &how, diag);
+    golden(&format!("{tag}_data_head"), &how, data);
+    golden(&format!("{tag}_fstat_head"), &how, fstat);
+}
+
+#[test]
+fn quick_shear_from_generated_scene() {
+    check("generated", None, "from the generated scene (seed 1)");
+}
+
+#[test]
+fn quick_shear_from_official_file() {
+    check(
+        "official",
+        Some(&shared("GranularShearFlow.data")),
+        "--init GranularShearFlow.data",
+    );
+}
+
+#[test]
+fn quick_shear_from_developed_state() {
+    check(
+        "developed",
+        Some(&shared("states/mercury_t143.85.data")),
+        "--init states/mercury_t143.85.data",
+    );
+}
