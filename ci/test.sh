@@ -4,6 +4,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+echo "== system packages"
+# The profile plots label their axes with DejaVu Sans (Debian fonts-dejavu-core).
+if [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ]; then
+  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq fonts-dejavu-core
+fi
+
 echo "== formatting and lints"
 cargo fmt --check
 cargo clippy --release --all-targets -- -D warnings

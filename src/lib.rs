@@ -6,6 +6,7 @@
 //! checkpoints) and [`diagnostics`].
 
 pub mod case;
+pub mod cg;
 pub mod checkpoint;
 pub mod contact;
 pub mod diagnostics;

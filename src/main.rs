@@ -6,6 +6,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 
 use verdem::case::Case;
+use verdem::cg::{self, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
 use verdem::run::{self, RunOptions};
 use verdem::{checkpoint, hash, scene};
@@ -64,6 +65,31 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Coarse-grain a MercuryCG series into z-profiles with error bars, checks and a plot.
+    Cg {
+        /// Series base name: DIR/NAME for DIR/NAME.data.NNNN and DIR/NAME.fstat.NNNN.
+        base: PathBuf,
+        /// First save (default: the second half of the series).
+        #[arg(long)]
+        from: Option<u64>,
+        /// Last save (default: the last).
+        #[arg(long)]
+        to: Option<u64>,
+        #[arg(long, default_value_t = 100)]
+        slices: usize,
+        #[arg(long, value_enum, default_value_t = KernelChoice::Heaviside)]
+        kernel: KernelChoice,
+        /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
+        #[arg(long)]
+        width: Option<f64>,
+        /// Case file telling which particles are walls and the density (default: the
+        /// benchmark's, ids 1-480 walls, density 1).
+        #[arg(long)]
+        case: Option<PathBuf>,
+        /// Blocks of saves for the standard errors.
+        #[arg(long, default_value_t = 10)]
+        blocks: usize,
+    },
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash {
         #[command(flatten)]
@@ -102,6 +128,29 @@ fn print_contact_summary(case: &Case) {
         }
     }
     println!("dt = {dt:e}");
+}
+
+/// Coarse-graining defaults for a case: its wall spheres, density and periodicity.
+fn cg_options_for(case: &Case) -> CgOptions {
+    let walls = match &case.scene {
+        verdem::case::Scene::BumpyShear {
+            wall_rows,
+            wall_per_row,
+            ..
+        } => 2 * wall_rows * wall_per_row,
+        verdem::case::Scene::Spheres { sphere } => sphere.iter().take_while(|s| s.fixed).count(),
+    };
+    CgOptions {
+        from: None,
+        to: None,
+        slices: 100,
+        kernel: KernelChoice::Heaviside,
+        width: None,
+        walls,
+        density: case.material.density,
+        periodic: case.domain.periodic,
+        blocks: 10,
+    }
 }
 
 fn real_main() -> anyhow::Result<()> {
@@ -176,6 +225,50 @@ fn real_main() -> anyhow::Result<()> {
             let p = opts.out_dir.join(format!("{}.summary.toml", case.name));
             verdem::io::atomic::write(&p, summary.as_bytes())
                 .with_context(|| p.display().to_string())?;
+            if s.saves > 0 {
+                let (_, report) =
+                    cg::write_all(&opts.out_dir.join(&case.name), &cg_options_for(&case))?;
+                println!(
+                    "profiles: {}",
+                    opts.out_dir
+                        .join(format!("{}.profiles.csv", case.name))
+                        .display()
+                );
+                print!("{report}");
+            }
+        }
+        Command::Cg {
+            base,
+            from,
+            to,
+            slices,
+            kernel,
+            width,
+            case,
+            blocks,
+        } => {
+            let mut o = match case {
+                Some(c) => cg_options_for(&Case::load(&c)?),
+                None => CgOptions {
+                    from: None,
+                    to: None,
+                    slices: 100,
+                    kernel: KernelChoice::Heaviside,
+                    width: None,
+                    walls: 480,
+                    density: 1.0,
+                    periodic: [true, true, false],
+                    blocks: 10,
+                },
+            };
+            o.from = from;
+            o.to = to;
+            o.slices = slices;
+            o.kernel = kernel;
+            o.width = width;
+            o.blocks = blocks;
+            let (_, report) = cg::write_all(&base, &o)?;
+            print!("{report}");
         }
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;

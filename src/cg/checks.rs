@@ -1,0 +1,228 @@
+//! Built-in physics checks of steady-state profiles: momentum balance, wall consistency, mass,
+//! symmetry, and a kinetic-theory sanity check (reported, never failed).
+
+use super::{columns, core_range, standard_error, Profiles, COLUMNS};
+
+/// One check: what was measured against what was expected, and whether it passed
+/// (`None`: reported only).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    pub name: String,
+    pub measured: String,
+    pub expected: String,
+    pub pass: Option<bool>,
+}
+
+fn col(name: &str) -> usize {
+    COLUMNS
+        .iter()
+        .position(|c| *c == name)
+        .expect("known column")
+}
+
+/// Reduced chi-square of values against their error-weighted mean.
+fn uniformity(v: &[f64], se: &[f64]) -> (f64, f64) {
+    let w: Vec<f64> = se.iter().map(|s| 1.0 / (s * s).max(1e-300)).collect();
+    let mean = v.iter().zip(&w).map(|(x, w)| x * w).sum::<f64>() / w.iter().sum::<f64>();
+    let chi2 = v
+        .iter()
+        .zip(se)
+        .map(|(x, s)| ((x - mean) / s.max(1e-300)).powi(2))
+        .sum::<f64>();
+    (mean, chi2 / (v.len() as f64 - 1.0).max(1.0))
+}
+
+/// Runs every check. `density` is the particle density (for the kinetic-theory check).
+pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
+    let core = core_range(&p.grid);
+    let cols: Vec<Vec<f64>> = p.mean.iter().map(columns).collect();
+    let get = |name: &str| -> (Vec<f64>, Vec<f64>) {
+        let c = col(name);
+        (
+            core.clone().map(|k| cols[k][c]).collect(),
+            core.clone().map(|k| p.se[k][c]).collect(),
+        )
+    };
+    let mut out = Vec::new();
+    let (z0, z1) = (p.grid.z(core.start), p.grid.z(core.end - 1));
+    let limit = 3.0;
+    // 1. Momentum balance: shear stress and σzz uniform across the core.
+    let (tau_mean, tau_chi) = {
+        let (v, se) = get("shear_xz");
+        uniformity(&v, &se)
+    };
+    out.push(Check {
+        name: format!("shear stress uniform for z in [{z0:.2}, {z1:.2}]"),
+        measured: format!("chi2/dof = {tau_chi:.2} (mean {tau_mean:.5})"),
+        expected: format!("< {limit}"),
+        pass: Some(tau_chi < limit),
+    });
+    let zz: Vec<f64> = core
+        .clone()
+        .map(|k| cols[k][col("kin_zz")] + cols[k][col("con_zz")])
+        .collect();
+    let zz_se: Vec<f64> = core
+        .clone()
+        .map(|k| (p.se[k][col("kin_zz")].powi(2) + p.se[k][col("con_zz")].powi(2)).sqrt())
+        .collect();
+    let (zz_mean, zz_chi) = uniformity(&zz, &zz_se);
+    out.push(Check {
+        name: format!("sigma_zz uniform for z in [{z0:.2}, {z1:.2}]"),
+        measured: format!("chi2/dof = {zz_chi:.2} (mean {zz_mean:.5})"),
+        expected: format!("< {limit}"),
+        pass: Some(zz_chi < limit),
+    });
+    // 2. Wall consistency: σ·n at each wall equals the wall force per area. Top wall (normal
+    // +z): σxz = F_top,x/A, σzz = F_top,z/A; bottom wall: σxz = −F_bot,x/A, σzz = −F_bot,z/A.
+    let area = p.domain.lengths().x * p.domain.lengths().y;
+    let blocks = p.blocks;
+    let per_block = |f: &dyn Fn(usize) -> f64| -> (f64, f64) {
+        let n = p.wall_force.len();
+        let vals: Vec<f64> = (0..blocks)
+            .map(|b| {
+                let (s, e) = (b * n / blocks, (b + 1) * n / blocks);
+                (s..e).map(f).sum::<f64>() / (e - s) as f64
+            })
+            .collect();
+        (
+            vals.iter().sum::<f64>() / vals.len() as f64,
+            standard_error(&vals),
+        )
+    };
+    // Standard errors of the core means, from the same blocks of saves as the profiles.
+    let block_core = |f: &dyn Fn(&super::fields::Derived) -> f64| -> f64 {
+        let n = p.per_save.len();
+        let vals: Vec<f64> = (0..blocks)
+            .map(|b| {
+                let d = super::fields::derive(&super::average(
+                    &p.per_save[b * n / blocks..(b + 1) * n / blocks],
+                ));
+                core.clone().map(|k| f(&d[k])).sum::<f64>() / core.len() as f64
+            })
+            .collect();
+        standard_error(&vals)
+    };
+    let tau_se = block_core(&|d| d.shear);
+    let zz_core_se = block_core(&|d| d.kinetic[(2, 2)] + d.contact[(2, 2)]);
+    for (label, g, sign) in [("top", 1usize, 1.0), ("bottom", 0usize, -1.0)] {
+        let (fx, fx_se) = per_block(&|s| sign * p.wall_force[s][g].x / area);
+        let (fz, fz_se) = per_block(&|s| sign * p.wall_force[s][g].z / area);
+        for (what, gap, wall, se_gap, se_wall) in [
+            ("xz", tau_mean, fx, tau_se, fx_se),
+            ("zz", zz_mean, fz, zz_core_se, fz_se),
+        ] {
+            let tol = 3.0 * (se_gap * se_gap + se_wall * se_wall).sqrt();
+            out.push(Check {
+                name: format!("sigma_{what} in the core = {label} wall force per area"),
+                measured: format!("{gap:.5} vs {wall:.5}"),
+                expected: format!("difference < 3 combined SE ({tol:.2e})"),
+                pass: Some((gap - wall).abs() <= tol),
+            });
+        }
+    }
+    // 3. Mass: ∫ ν dz · Lx·Ly = Σ V_i, per save.
+    let h = p.grid.h();
+    let worst = p
+        .per_save
+        .iter()
+        .map(|r| (r.nu.iter().sum::<f64>() * h * area - p.free_volume).abs() / p.free_volume)
+        .fold(0.0, f64::max);
+    let exact = matches!(p.kernel, super::kernel::Kernel::Heaviside { .. });
+    let tol = if exact { 1e-12 } else { 1e-3 };
+    out.push(Check {
+        name: format!(
+            "mass: integral of nu dz * Lx * Ly = {} free spheres' volume",
+            p.free
+        ),
+        measured: format!(
+            "max relative error {worst:.2e} over {} saves",
+            p.per_save.len()
+        ),
+        expected: format!("< {tol:e}"),
+        pass: Some(worst < tol),
+    });
+    // 4. Symmetry about the mid-plane.
+    let n = p.grid.n;
+    for (name, sign) in [("nu", 1.0), ("T", 1.0), ("pressure", 1.0), ("vx", -1.0)] {
+        let c = col(name);
+        let pairs: Vec<f64> = (0..n / 2)
+            .map(|k| {
+                let (a, b) = (cols[k][c], sign * cols[n - 1 - k][c]);
+                let se = (p.se[k][c].powi(2) + p.se[n - 1 - k][c].powi(2)).sqrt();
+                if se > 0.0 {
+                    ((a - b) / se).powi(2)
+                } else if a == b {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        let chi = pairs.iter().sum::<f64>() / pairs.len() as f64;
+        out.push(Check {
+            name: format!(
+                "{} {name} about the mid-plane",
+                if sign > 0.0 {
+                    "symmetric"
+                } else {
+                    "antisymmetric"
+                }
+            ),
+            measured: format!("chi2/dof = {chi:.2}"),
+            expected: format!("< {limit}"),
+            pass: Some(chi < limit),
+        });
+    }
+    // 5. Kinetic theory: p/(ρp ν T) against 1 + 2(1+e) ν g0(ν), Carnahan–Starling g0 (reported).
+    let e = 0.902;
+    let ratios: Vec<f64> = core
+        .clone()
+        .filter(|&k| p.mean[k].temperature > 0.0 && p.mean[k].nu > 0.0)
+        .map(|k| {
+            let d = &p.mean[k];
+            let g0 = (2.0 - d.nu) / (2.0 * (1.0 - d.nu).powi(3));
+            let theory = 1.0 + 2.0 * (1.0 + e) * d.nu * g0;
+            d.pressure / (density * d.nu * d.temperature) / theory
+        })
+        .collect();
+    let mean_ratio = ratios.iter().sum::<f64>() / ratios.len().max(1) as f64;
+    out.push(Check {
+        name: "kinetic theory p/(rho_p nu T) / (1 + 2(1+e) nu g0), core mean".into(),
+        measured: format!("{mean_ratio:.3}"),
+        expected: "about 1 (within ~20%; reported only)".into(),
+        pass: None,
+    });
+    out
+}
+
+/// A plain-text table of the checks, with the averaging facts a reviewer needs.
+pub fn report(p: &Profiles, checks: &[Check]) -> String {
+    let block_len = p.saves.len() as f64 / p.blocks as f64;
+    let tau = p.tau_shear.max(p.tau_energy);
+    let mut s = format!(
+        "saves {}..{} ({}), kernel {:?}, {} slices, {} blocks of {:.1} saves; integrated autocorrelation time {:.2} saves (shear), {:.2} (kinetic energy): blocks {} independent (block length {} 2 tau)\n",
+        p.saves.first().unwrap_or(&0),
+        p.saves.last().unwrap_or(&0),
+        p.saves.len(),
+        p.kernel,
+        p.grid.n,
+        p.blocks,
+        block_len,
+        p.tau_shear,
+        p.tau_energy,
+        if block_len >= 2.0 * tau { "are" } else { "are NOT" },
+        if block_len >= 2.0 * tau { ">=" } else { "<" },
+    );
+    for c in checks {
+        let verdict = match c.pass {
+            Some(true) => "PASS",
+            Some(false) => "FAIL",
+            None => "info",
+        };
+        s.push_str(&format!(
+            "{verdict:4}  {}: {} (expected {})\n",
+            c.name, c.measured, c.expected
+        ));
+    }
+    s
+}

@@ -1,0 +1,380 @@
+//! Coarse-graining of a MercuryCG-format series (`NAME.data.NNNN` + `NAME.fstat.NNNN`) into
+//! z-profiles, time-averaged as MercuryCG's `-timeaverage` (raw fields first, derived fields from
+//! the averages), with standard errors from block averaging over saves, built-in physics checks
+//! and a plot. Any code's output in this format is judged by the same yardstick.
+
+pub mod checks;
+pub mod fields;
+pub mod kernel;
+pub mod plot;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use rayon::prelude::*;
+
+use crate::domain::Domain;
+use crate::io::mercury;
+use fields::{derive, raw_fields, Derived, Grid, Raw};
+use kernel::Kernel;
+
+/// What to coarse-grain and how.
+#[derive(Clone, Debug)]
+pub struct CgOptions {
+    /// First save (default: the second half of the series).
+    pub from: Option<u64>,
+    /// Last save (default: the last one).
+    pub to: Option<u64>,
+    pub slices: usize,
+    pub kernel: KernelChoice,
+    /// Kernel width (Gauss: standard deviation; Lucy: cutoff); default the slice height.
+    pub width: Option<f64>,
+    /// Particles with index < `walls` are wall spheres (the benchmark: 480).
+    pub walls: usize,
+    /// Particle density.
+    pub density: f64,
+    /// Periodicity of x, y, z (the box itself comes from the files).
+    pub periodic: [bool; 3],
+    /// Number of blocks for the standard errors.
+    pub blocks: usize,
+}
+
+/// Kernel families.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum KernelChoice {
+    Heaviside,
+    Gauss,
+    Lucy,
+}
+
+/// A series of saves on disk.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub dir: PathBuf,
+    pub name: String,
+    /// Save numbers present (both `.data` and `.fstat`), increasing.
+    pub saves: Vec<u64>,
+}
+
+impl Series {
+    /// Finds the saves of `base` = `DIR/NAME`.
+    pub fn find(base: &Path) -> anyhow::Result<Series> {
+        let dir = base
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf();
+        let name = base
+            .file_name()
+            .and_then(|n| n.to_str())
+            .with_context(|| format!("{}: not a series base name", base.display()))?
+            .to_string();
+        let prefix = format!("{name}.data.");
+        let mut saves = Vec::new();
+        for entry in
+            std::fs::read_dir(&dir).with_context(|| format!("{}: cannot list", dir.display()))?
+        {
+            let file = entry?.file_name();
+            let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+                continue;
+            };
+            if let Ok(k) = rest.parse::<u64>() {
+                if dir.join(format!("{name}.fstat.{rest}")).exists() {
+                    saves.push(k);
+                }
+            }
+        }
+        saves.sort_unstable();
+        if saves.is_empty() {
+            bail!(
+                "{}: no {name}.data.NNNN with a matching .fstat.NNNN",
+                dir.display()
+            );
+        }
+        Ok(Series { dir, name, saves })
+    }
+
+    fn path(&self, ext: &str, k: u64) -> PathBuf {
+        crate::run::save_path(&self.dir, &self.name, ext, k)
+    }
+}
+
+/// Profiles with standard errors.
+#[derive(Clone, Debug)]
+pub struct Profiles {
+    pub grid: Grid,
+    pub kernel: Kernel,
+    pub saves: Vec<u64>,
+    pub blocks: usize,
+    /// Time-averaged derived fields.
+    pub mean: Vec<Derived>,
+    /// Standard error of each column of [`columns`], per grid point.
+    pub se: Vec<Vec<f64>>,
+    /// Per save: the raw fields (for the checks).
+    pub per_save: Vec<Raw>,
+    /// Per save: force of the free particles on the bottom and top walls (from the fstat rows).
+    pub wall_force: Vec<[crate::Vec3; 2]>,
+    pub domain: Domain,
+    /// Number of free particles and their total volume.
+    pub free: usize,
+    pub free_volume: f64,
+    /// Integrated autocorrelation time (in saves) of the core-averaged shear stress and of the
+    /// core-averaged kinetic energy density.
+    pub tau_shear: f64,
+    pub tau_energy: f64,
+}
+
+/// Column names of [`columns`] (after `z`).
+pub const COLUMNS: [&str; 26] = [
+    "nu", "rho", "vx", "vy", "vz", "T", "kin_xx", "kin_xy", "kin_xz", "kin_yx", "kin_yy", "kin_yz",
+    "kin_zx", "kin_zy", "kin_zz", "con_xx", "con_xy", "con_xz", "con_yx", "con_yy", "con_yz",
+    "con_zx", "con_zy", "con_zz", "pressure", "shear_xz",
+];
+
+/// The values of [`COLUMNS`] for one grid point.
+pub fn columns(d: &Derived) -> Vec<f64> {
+    let mut c = vec![
+        d.nu,
+        d.rho,
+        d.velocity.x,
+        d.velocity.y,
+        d.velocity.z,
+        d.temperature,
+    ];
+    for m in [&d.kinetic, &d.contact] {
+        for r in 0..3 {
+            for s in 0..3 {
+                c.push(m[(r, s)]);
+            }
+        }
+    }
+    c.push(d.pressure);
+    c.push(d.shear);
+    c
+}
+
+/// Coarse-grains a series.
+pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> {
+    let n = series.saves.len();
+    let first = o.from.unwrap_or(series.saves[n.div_ceil(2).min(n - 1)]);
+    let last = o.to.unwrap_or(series.saves[n - 1]);
+    let saves: Vec<u64> = series
+        .saves
+        .iter()
+        .copied()
+        .filter(|&k| k >= first && k <= last)
+        .collect();
+    if saves.is_empty() {
+        bail!(
+            "no saves between {first} and {last} in {}",
+            series.dir.display()
+        );
+    }
+    let head = mercury::read_data(&series.path("data", saves[0]))?;
+    let domain = Domain::new(head.domain_lo, head.domain_hi, o.periodic);
+    let grid = Grid {
+        z0: head.domain_lo.z,
+        z1: head.domain_hi.z,
+        n: o.slices,
+    };
+    let h = grid.h();
+    let width = o.width.unwrap_or(h);
+    let kernel = match o.kernel {
+        KernelChoice::Heaviside => Kernel::Heaviside { h },
+        KernelChoice::Gauss => Kernel::Gauss { w: width },
+        KernelChoice::Lucy => Kernel::Lucy { c: width },
+    };
+    let walls = o.walls;
+    let is_wall = move |i: usize| i < walls;
+    let per: Vec<anyhow::Result<(Raw, [crate::Vec3; 2])>> = saves
+        .par_iter()
+        .map(|&k| {
+            let data = mercury::read_data(&series.path("data", k))?;
+            let fstat = mercury::read_fstat(&series.path("fstat", k))?;
+            if data.rows.len() != head.rows.len() {
+                bail!(
+                    "{}: {} particles, save {} has {}",
+                    series.path("data", k).display(),
+                    data.rows.len(),
+                    saves[0],
+                    head.rows.len()
+                );
+            }
+            let raw = raw_fields(&data, &fstat, &is_wall, &domain, &grid, kernel, o.density);
+            Ok((raw, wall_forces(&fstat, &is_wall, &data)))
+        })
+        .collect();
+    let mut per_save = Vec::with_capacity(saves.len());
+    let mut wall_force = Vec::with_capacity(saves.len());
+    for r in per {
+        let (raw, wf) = r?;
+        per_save.push(raw);
+        wall_force.push(wf);
+    }
+    let mean_raw = average(&per_save);
+    let mean = derive(&mean_raw);
+    let blocks = o.blocks.clamp(1, per_save.len());
+    let block_cols: Vec<Vec<Vec<f64>>> = (0..blocks)
+        .map(|b| {
+            let (s, e) = (
+                b * per_save.len() / blocks,
+                (b + 1) * per_save.len() / blocks,
+            );
+            derive(&average(&per_save[s..e]))
+                .iter()
+                .map(columns)
+                .collect()
+        })
+        .collect();
+    let se = (0..grid.n)
+        .map(|k| {
+            (0..COLUMNS.len())
+                .map(|c| {
+                    let vals: Vec<f64> = block_cols.iter().map(|b| b[k][c]).collect();
+                    standard_error(&vals)
+                })
+                .collect()
+        })
+        .collect();
+    let free = head.rows.len().saturating_sub(walls);
+    let free_volume = head.rows[walls.min(head.rows.len())..]
+        .iter()
+        .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.radius.powi(3))
+        .sum();
+    let core = core_range(&grid);
+    let series_of = |f: &dyn Fn(&Derived) -> f64| -> Vec<f64> {
+        per_save
+            .iter()
+            .map(|raw| {
+                let d = derive(raw);
+                core.clone().map(|k| f(&d[k])).sum::<f64>() / core.len() as f64
+            })
+            .collect()
+    };
+    let tau_shear = integrated_autocorrelation(&series_of(&|d| d.shear));
+    let tau_energy = integrated_autocorrelation(&series_of(&|d| d.kinetic.trace()));
+    Ok(Profiles {
+        grid,
+        kernel,
+        saves,
+        blocks,
+        mean,
+        se,
+        per_save,
+        wall_force,
+        domain,
+        free,
+        free_volume,
+        tau_shear,
+        tau_energy,
+    })
+}
+
+/// Grid points of the core: at least two diameters from the walls' surfaces (z ∈ [3, 19] for
+/// the benchmark's box [0, 22]).
+pub fn core_range(grid: &Grid) -> std::ops::Range<usize> {
+    let (lo, hi) = (grid.z0 + 3.0, grid.z1 - 3.0);
+    let first = (0..grid.n).find(|&k| grid.z(k) >= lo).unwrap_or(0);
+    let last = (0..grid.n)
+        .rev()
+        .find(|&k| grid.z(k) <= hi)
+        .unwrap_or(grid.n - 1);
+    first..last + 1
+}
+
+/// Force of the free particles on the bottom (0) and top (1) wall spheres (below or above the
+/// box's mid-height), from the fstat rows (each free–wall contact once, free particle first; the
+/// wall gets the opposite of the force on the free particle).
+fn wall_forces(
+    fstat: &mercury::FstatFile,
+    is_wall: &dyn Fn(usize) -> bool,
+    data: &mercury::DataFile,
+) -> [crate::Vec3; 2] {
+    let mid = 0.5 * (data.domain_lo.z + data.domain_hi.z);
+    let mut out = [crate::Vec3::zeros(); 2];
+    for r in &fstat.rows {
+        if !is_wall(r.i) && is_wall(r.j) {
+            let g = usize::from(data.rows[r.j].x.z > mid);
+            out[g] -= r.fn_signed * r.n + r.ft * r.t;
+        }
+    }
+    out
+}
+
+fn average(raws: &[Raw]) -> Raw {
+    let mut m = Raw::zeros(raws[0].nu.len());
+    for r in raws {
+        m.add_scaled(r, 1.0 / raws.len() as f64);
+    }
+    m
+}
+
+/// Standard error of the mean of independent values (0 for fewer than two).
+pub fn standard_error(v: &[f64]) -> f64 {
+    let n = v.len() as f64;
+    if v.len() < 2 {
+        return 0.0;
+    }
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (var / n).sqrt()
+}
+
+/// Integrated autocorrelation time τ = 1/2 + Σ ρ(t), summed up to the first window W ≥ 5τ
+/// (Sokal's automatic window), in units of the series' spacing.
+pub fn integrated_autocorrelation(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n < 4 {
+        return f64::NAN;
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let c0 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+    if c0 == 0.0 {
+        return 0.5;
+    }
+    let mut tau = 0.5;
+    for t in 1..n / 2 {
+        let c = (0..n - t)
+            .map(|i| (x[i] - mean) * (x[i + t] - mean))
+            .sum::<f64>()
+            / n as f64;
+        tau += c / c0;
+        if t as f64 >= 5.0 * tau {
+            break;
+        }
+    }
+    tau.max(0.5)
+}
+
+/// The profiles as CSV: z, then every column of [`COLUMNS`] followed by its standard error.
+pub fn csv(p: &Profiles) -> String {
+    let mut s = String::from("z");
+    for c in COLUMNS {
+        s.push_str(&format!(",{c},{c}_se"));
+    }
+    s.push('\n');
+    for k in 0..p.grid.n {
+        crate::io::fmt_f64(&mut s, p.grid.z(k));
+        for (c, v) in columns(&p.mean[k]).iter().enumerate() {
+            s.push(',');
+            crate::io::fmt_f64(&mut s, *v);
+            s.push(',');
+            crate::io::fmt_f64(&mut s, p.se[k][c]);
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Coarse-grains `base` and writes `NAME.profiles.csv`, `NAME.profiles.png` and
+/// `NAME.checks.txt` beside it; returns the profiles and the checks' report.
+pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
+    let series = Series::find(base)?;
+    let p = coarse_grain(&series, o)?;
+    let out = |ext: &str| series.dir.join(format!("{}.{ext}", series.name));
+    crate::io::atomic::write(&out("profiles.csv"), csv(&p).as_bytes())?;
+    let report = checks::report(&p, &checks::run(&p, o.density));
+    crate::io::atomic::write(&out("checks.txt"), report.as_bytes())?;
+    plot::profiles_png(&p, &out("profiles.png"))?;
+    Ok((p, report))
+}

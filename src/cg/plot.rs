@@ -1,0 +1,148 @@
+//! The five benchmark profiles against z, with error bands, as a PNG.
+
+use std::path::Path;
+
+use anyhow::Context;
+use plotters::prelude::*;
+
+use super::{columns, Profiles, COLUMNS};
+
+/// The TrueType font used for labels (Debian package `fonts-dejavu-core`).
+pub const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+fn register_font() -> anyhow::Result<()> {
+    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        let bytes = std::fs::read(FONT)
+            .map_err(|e| format!("{FONT}: {e} (install the Debian package fonts-dejavu-core)"))?;
+        plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            Box::leak(bytes.into_boxed_slice()),
+        )
+        .map_err(|_| format!("{FONT}: not a usable font"))
+    })
+    .clone()
+    .map_err(anyhow::Error::msg)
+}
+
+/// One panel: a column against z, with a band of ±2 standard errors.
+pub struct Curve<'a> {
+    pub label: &'a str,
+    pub z: Vec<f64>,
+    pub value: Vec<f64>,
+    pub se: Vec<f64>,
+}
+
+/// The curves of the five benchmark panels for one set of profiles.
+pub fn benchmark_curves(p: &Profiles) -> Vec<(String, Curve<'static>)> {
+    let panels = [
+        ("vx", "velocity vx"),
+        ("nu", "volume fraction"),
+        ("T", "granular temperature"),
+        ("pressure", "pressure"),
+        ("shear_xz", "shear stress xz"),
+    ];
+    let z: Vec<f64> = (0..p.grid.n).map(|k| p.grid.z(k)).collect();
+    panels
+        .iter()
+        .map(|(col, title)| {
+            let c = COLUMNS.iter().position(|n| n == col).expect("known column");
+            (
+                title.to_string(),
+                Curve {
+                    label: "",
+                    z: z.clone(),
+                    value: p.mean.iter().map(|d| columns(d)[c]).collect(),
+                    se: p.se.iter().map(|s| s[c]).collect(),
+                },
+            )
+        })
+        .collect()
+}
+
+/// Draws panels of curves (one or more codes per panel) into a PNG.
+pub fn panels_png(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> {
+    register_font()?;
+    // Drawn beside the target and renamed: an interrupted run never leaves half a picture.
+    let tmp = path.with_extension("part.png");
+    draw(panels, &tmp)?;
+    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+}
+
+fn draw(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> {
+    let root = BitMapBackend::new(path, (360 * panels.len() as u32, 520)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly((1, panels.len()));
+    let colours = [BLUE, RED, GREEN, MAGENTA, BLACK];
+    for ((title, curves), area) in panels.iter().zip(areas.iter()) {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for c in curves {
+            for (v, s) in c.value.iter().zip(&c.se) {
+                lo = lo.min(v - 2.0 * s);
+                hi = hi.max(v + 2.0 * s);
+            }
+        }
+        if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+            hi = lo + 1.0;
+        }
+        let pad = 0.05 * (hi - lo);
+        let zmax = curves
+            .iter()
+            .flat_map(|c| c.z.iter().copied())
+            .fold(0.0, f64::max)
+            + 0.5;
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 18))
+            .margin(8)
+            .x_label_area_size(36)
+            .y_label_area_size(52)
+            .build_cartesian_2d(lo - pad..hi + pad, 0.0..zmax)?;
+        chart
+            .configure_mesh()
+            .x_labels(4)
+            .y_desc("z")
+            .label_style(("sans-serif", 13))
+            .draw()?;
+        for (c, colour) in curves.iter().zip(colours.iter().cycle()) {
+            let band: Vec<(f64, f64)> =
+                c.z.iter()
+                    .zip(c.value.iter().zip(&c.se))
+                    .map(|(z, (v, s))| (v - 2.0 * s, *z))
+                    .chain(
+                        c.z.iter()
+                            .zip(c.value.iter().zip(&c.se))
+                            .rev()
+                            .map(|(z, (v, s))| (v + 2.0 * s, *z)),
+                    )
+                    .collect();
+            chart.draw_series(std::iter::once(Polygon::new(band, colour.mix(0.25))))?;
+            let line = chart.draw_series(LineSeries::new(
+                c.value.iter().zip(&c.z).map(|(v, z)| (*v, *z)),
+                colour,
+            ))?;
+            if !c.label.is_empty() {
+                line.label(c.label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+            }
+        }
+        if curves.iter().any(|c| !c.label.is_empty()) {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
+        }
+    }
+    root.present()
+        .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// The five benchmark profiles of one run.
+pub fn profiles_png(p: &Profiles, path: &Path) -> anyhow::Result<()> {
+    let panels: Vec<(String, Vec<Curve<'_>>)> = benchmark_curves(p)
+        .into_iter()
+        .map(|(t, c)| (t, vec![c]))
+        .collect();
+    panels_png(&panels, path)
+}

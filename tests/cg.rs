@@ -1,0 +1,295 @@
+//! Coarse-graining against synthetic series with known answers, and the reader's errors.
+
+mod common;
+
+use std::path::Path;
+
+use verdem::cg::{self, CgOptions, KernelChoice, COLUMNS};
+use verdem::io::mercury;
+
+const AREA: f64 = 4.0 * 5.0;
+
+fn options(walls: usize, kernel: KernelChoice) -> CgOptions {
+    CgOptions {
+        from: Some(0),
+        to: None,
+        slices: 10,
+        kernel,
+        width: Some(0.7),
+        walls,
+        density: 1.0,
+        periodic: [true, true, false],
+        blocks: 2,
+    }
+}
+
+/// Writes save `k` of series `name` in `dir`: particles `(x, v)` of radius 0.5, and fstat rows.
+fn save(dir: &Path, k: u64, particles: &[([f64; 3], [f64; 3])], rows: &[String]) {
+    let mut d = format!("{} 0 0 0 0 4 5 10\n", particles.len());
+    for (x, v) in particles {
+        d.push_str(&format!(
+            "{} {} {} {} {} {} 0.5 0 0 0 0 0 0 0\n",
+            x[0], x[1], x[2], v[0], v[1], v[2]
+        ));
+    }
+    std::fs::write(dir.join(format!("s.data.{k:04}")), d).unwrap();
+    let mut f = String::from("# 0 1\n# 0 0 0 4 5 10\n# 0.5 0.5 0 0 0 0\n");
+    for r in rows {
+        f.push_str(r);
+        f.push('\n');
+    }
+    std::fs::write(dir.join(format!("s.fstat.{k:04}")), f).unwrap();
+}
+
+fn profiles(dir: &Path, o: &CgOptions) -> cg::Profiles {
+    cg::coarse_grain(&cg::Series::find(&dir.join("s")).unwrap(), o).unwrap()
+}
+
+#[test]
+fn uniform_velocity_lattice_has_exact_velocity_and_zero_temperature() {
+    let dir = tempfile::tempdir().unwrap();
+    let lattice: Vec<_> = (0..40)
+        .map(|a| {
+            (
+                [
+                    (a % 4) as f64 + 0.5,
+                    (a / 4 % 5) as f64 + 0.5,
+                    1.0 + (a / 20) as f64 * 5.0,
+                ],
+                [0.3, -0.1, 0.0],
+            )
+        })
+        .collect();
+    for k in 0..4 {
+        save(dir.path(), k, &lattice, &[]);
+    }
+    let p = profiles(dir.path(), &options(0, KernelChoice::Heaviside));
+    let mut seen = 0;
+    for d in &p.mean {
+        if d.rho > 0.0 {
+            seen += 1;
+            assert!((d.velocity.x - 0.3).abs() < 1e-15 && (d.velocity.y + 0.1).abs() < 1e-15);
+            assert!(d.temperature.abs() < 1e-15, "T = {}", d.temperature);
+        }
+    }
+    assert_eq!(seen, 2);
+}
+
+#[test]
+fn prescribed_random_velocities_give_the_exact_temperature() {
+    let dir = tempfile::tempdir().unwrap();
+    // 12 particles in one slice (z in [5, 6)); velocities spread about their mean
+    let parts: Vec<_> = (0..12)
+        .map(|a| {
+            let s = a as f64;
+            (
+                [s % 4.0, (s * 0.37) % 5.0, 5.5],
+                [
+                    0.2 + 0.1 * (s * 1.3).sin(),
+                    0.05 * (s * 2.1).cos(),
+                    -0.07 * (s * 0.7).sin(),
+                ],
+            )
+        })
+        .collect();
+    save(dir.path(), 0, &parts, &[]);
+    save(dir.path(), 1, &parts, &[]);
+    let p = profiles(dir.path(), &options(0, KernelChoice::Heaviside));
+    let n = parts.len() as f64;
+    let mean: [f64; 3] = [0, 1, 2].map(|c| parts.iter().map(|(_, v)| v[c]).sum::<f64>() / n);
+    let t = parts
+        .iter()
+        .map(|(_, v)| (0..3).map(|c| (v[c] - mean[c]).powi(2)).sum::<f64>())
+        .sum::<f64>()
+        / (3.0 * n);
+    let slice = &p.mean[5];
+    assert!(
+        (slice.temperature - t).abs() < 1e-14 * t.max(1.0),
+        "{} vs {t}",
+        slice.temperature
+    );
+    let m = std::f64::consts::PI / 6.0;
+    assert!((slice.nu - n * m / (AREA * 1.0)).abs() < 1e-15);
+}
+
+/// One static contact whose branch crosses three slices: the contact stress is split between
+/// them by the length of branch in each, and its integral over z times the area is f⊗l.
+#[test]
+fn contact_straddling_slices_integrates_to_f_outer_l() {
+    for kernel in [
+        KernelChoice::Heaviside,
+        KernelChoice::Gauss,
+        KernelChoice::Lucy,
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        // i at z = 6.3 (above), j at z = 4.4: n from j to i
+        let (zi, zj) = (6.3, 4.4);
+        let l = [0.6, 0.0, zi - zj];
+        let len = l[0] * l[0] + l[2] * l[2];
+        let n = [l[0] / len.sqrt(), 0.0, l[2] / len.sqrt()];
+        let (fnn, ft) = (2.0, 0.5);
+        let t = [n[2], 0.0, -n[0]];
+        let row = |a: usize, b: usize, s: f64| {
+            format!(
+                "0 {a} {b} 2 2 5 0.01 0 {fnn} {ft} {} {} {} {} {} {}",
+                s * n[0],
+                0.0,
+                s * n[2],
+                s * t[0],
+                0.0,
+                s * t[2]
+            )
+        };
+        let parts = [([2.6, 2.0, zi], [0.0; 3]), ([2.0, 2.0, zj], [0.0; 3])];
+        save(dir.path(), 0, &parts, &[row(0, 1, 1.0), row(1, 0, -1.0)]);
+        let mut o = options(0, kernel);
+        // smooth kernels are sampled finely enough for the sum over grid points to integrate
+        o.slices = if kernel == KernelChoice::Heaviside {
+            10
+        } else {
+            200
+        };
+        let p = profiles(dir.path(), &o);
+        let h = p.grid.h();
+        let f = [fnn * n[0] + ft * t[0], 0.0, fnn * n[2] + ft * t[2]];
+        for (r, c) in [(0, 0), (0, 2), (2, 0), (2, 2)] {
+            let integral: f64 = p.mean.iter().map(|d| d.contact[(r, c)]).sum::<f64>() * h * AREA;
+            let expected = f[r] * l[c];
+            let tol = if kernel == KernelChoice::Heaviside {
+                1e-12
+            } else {
+                2e-2
+            };
+            assert!(
+                (integral - expected).abs() < tol * expected.abs().max(1e-3),
+                "{kernel:?} ({r},{c}): {integral} vs {expected}"
+            );
+        }
+        if kernel == KernelChoice::Heaviside {
+            // slice 4 = [4, 5): branch from 4.4 to 5.0 is 0.6 of 1.9; slice 5 = 1.0/1.9; slice 6 = 0.3/1.9
+            let zz = |k: usize| p.mean[k].contact[(2, 2)] * h * AREA / (f[2] * l[2]);
+            for (k, frac) in [(4, 0.6 / 1.9), (5, 1.0 / 1.9), (6, 0.3 / 1.9)] {
+                assert!(
+                    (zz(k) - frac).abs() < 1e-12,
+                    "slice {k}: {} vs {frac}",
+                    zz(k)
+                );
+            }
+        }
+    }
+}
+
+/// A free–wall contact: the branch runs from the contact point to the free sphere's centre only,
+/// and the wall sphere carries no mass.
+#[test]
+fn contact_with_a_wall_sphere_uses_the_branch_from_the_contact_point() {
+    let dir = tempfile::tempdir().unwrap();
+    // particle 0 is a wall sphere at z = 0.5; free particle 1 above at z = 1.45
+    let parts = [
+        ([2.0, 2.0, 0.5], [-1.0, 0.0, 0.0]),
+        ([2.0, 2.0, 1.45], [0.0; 3]),
+    ];
+    let row = "0 1 0 2 2 0.975 0.05 0 10 0 0 0 1 0 0 0".to_string();
+    save(dir.path(), 0, &parts, &[row]);
+    let p = profiles(dir.path(), &options(1, KernelChoice::Heaviside));
+    let h = p.grid.h();
+    let integral: f64 = p.mean.iter().map(|d| d.contact[(2, 2)]).sum::<f64>() * h * AREA;
+    assert!(
+        (integral - 10.0 * (1.45 - 0.975)).abs() < 1e-12,
+        "{integral}"
+    );
+    let mass: f64 = p.mean.iter().map(|d| d.rho).sum::<f64>() * h * AREA;
+    assert!(
+        (mass - std::f64::consts::PI / 6.0).abs() < 1e-14,
+        "wall sphere counted: {mass}"
+    );
+    // the free sphere pushes the wall down: force on wall group 0 is −10 z
+    assert_eq!(p.wall_force[0][0].z, -10.0);
+}
+
+/// verdem's own output reads back: the mass check is exact and the files pass the checks' mass
+/// line.
+#[test]
+fn coarse_grains_a_series_verdem_wrote() {
+    let case = common::quick_case();
+    let dir = tempfile::tempdir().unwrap();
+    let mut e = common::engine(
+        &case,
+        Some(&common::shared("states/mercury_t143.85.data")),
+        Default::default(),
+    );
+    let opts = verdem::run::RunOptions {
+        end_step: 2000,
+        save_every: 500,
+        checkpoint_every: 0,
+        out_dir: dir.path().to_path_buf(),
+        name: "s".into(),
+        tag: "s".into(),
+        progress: false,
+        write_saves: true,
+    };
+    verdem::run::run(e.as_mut(), &opts, false).unwrap();
+    let mut o = options(480, KernelChoice::Heaviside);
+    o.slices = 100;
+    let (p, report) = cg::write_all(&dir.path().join("s"), &o).unwrap();
+    assert!(report.contains("PASS  mass"), "{report}");
+    assert!(dir.path().join("s.profiles.png").exists());
+    let csv = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 101);
+    assert_eq!(
+        csv.lines().next().unwrap().split(',').count(),
+        1 + 2 * COLUMNS.len()
+    );
+    assert!(p.mean.iter().map(|d| d.nu).sum::<f64>() > 0.0);
+}
+
+#[test]
+fn malformed_files_are_rejected_with_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let ok_line = "1 2 3 0 0 0 0.5 0 0 0 0 0 0 0";
+    let e = mercury::read_data(&bad(
+        "a.data",
+        &format!("2 0 0 0 0 4 5 10\n{ok_line}\n1 2 3\n"),
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("a.data:3:") && e.to_string().contains("expected 14 columns"),
+        "{e}"
+    );
+    let e = mercury::read_data(&bad(
+        "b.data",
+        &format!("3 0 0 0 0 4 5 10\n{ok_line}\n{ok_line}\n"),
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("header announces 3 particles but the file has 2"),
+        "{e}"
+    );
+    let e = mercury::read_data(&bad(
+        "c.data",
+        &format!(
+            "1 0 0 0 0 4 5 10\n{}\n",
+            ok_line.replace("1 2 3", "1 NaN 3")
+        ),
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("c.data:2:") && e.to_string().contains("not finite"),
+        "{e}"
+    );
+    let e = mercury::read_fstat(&bad(
+        "d.fstat",
+        "# 0 1\n# 0 0 0 4 5 10\n# 0.5 0.5 0 0 0 0\n0 1 2 3\n",
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("d.fstat:4:") && e.to_string().contains("expected 16 columns"),
+        "{e}"
+    );
+}
