@@ -125,7 +125,7 @@ fn contact_straddling_slices_integrates_to_f_outer_l() {
         // i at z = 6.3 (above), j at z = 4.4: n from j to i
         let (zi, zj) = (6.3, 4.4);
         let l = [0.6, 0.0, zi - zj];
-        let len = l[0] * l[0] + l[2] * l[2];
+        let len: f64 = l[0] * l[0] + l[2] * l[2];
         let n = [l[0] / len.sqrt(), 0.0, l[2] / len.sqrt()];
         let (fnn, ft) = (2.0, 0.5);
         let t = [n[2], 0.0, -n[0]];
