@@ -16,7 +16,7 @@
 //! per step. No float is ever summed in an order that depends on the thread count, the memory
 //! order of the particles, the skin or the cell size, so results are bitwise identical for all.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 use crate::contact::{ContactLaw, PairForce, PairInput};
@@ -92,6 +92,9 @@ pub struct Core {
     /// Worker threads of the step.
     pub threads: usize,
     pub times: StageTimes,
+    /// Set by the pair pass for both particles of every contact, read and cleared by the next
+    /// particle pass: a particle without contacts skips the gather (its sum is exactly zero).
+    touched: Vec<AtomicBool>,
     builder: NeighborBuilder,
     scratch: Scratch,
 }
@@ -146,6 +149,7 @@ impl Core {
             moved_bound: 0.0,
             threads,
             times: StageTimes::default(),
+            touched: Vec::new(),
             builder,
             scratch: Scratch {
                 particle_ranges: vec![(0, 0); threads],
@@ -170,6 +174,7 @@ impl Core {
             builder: &mut self.builder,
             scratch: &mut self.scratch,
             times: &mut self.times,
+            touched: &mut self.touched,
         }
     }
 
@@ -317,20 +322,22 @@ impl<L: ContactLaw> Simulation<L> {
     fn initial_forces(&mut self) {
         self.core.rebuild();
         let c = &mut self.core;
-        let pt = &mut c.particles;
+        let parts = ParticleSlices::of(&c.particles);
         for k in 0..c.pairs.p.len() {
+            let (p, i) = (c.pairs.p[k] as usize, c.pairs.i[k] as usize);
             pair_force::<L, true>(
                 &self.law,
                 &c.domain,
                 c.dt,
-                k,
-                &c.pairs,
-                pt,
+                p,
+                i,
+                &parts,
                 &mut c.xi[k],
                 &mut c.active[k],
                 &mut c.out[k],
             );
         }
+        let pt = &mut c.particles;
         for a in 0..pt.len() {
             let (f, t) = gather(a, &c.pairs, &c.active, &c.out);
             pt.f[a] = f;
@@ -465,6 +472,7 @@ struct ListState<'a> {
     builder: &'a mut NeighborBuilder,
     scratch: &'a mut Scratch,
     times: &'a mut StageTimes,
+    touched: &'a mut Vec<AtomicBool>,
 }
 
 fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
@@ -510,6 +518,9 @@ impl ListState<'_> {
                 motion[a] == Motion::Free || motion[b] == Motion::Free
             });
         let n_pairs = self.pairs.p.len();
+        // All clear between a particle pass and a pair pass; only the length can change.
+        self.touched
+            .resize_with(pt.len(), || AtomicBool::new(false));
         // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
         let owner = &self.pairs.owner_start;
@@ -612,18 +623,33 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     let pt = view.particles.get();
     let dt = view.dt;
     let mut vmax2: f64 = 0.0;
+    // Plain slices of this thread's range: bounds and base pointers stay in registers.
+    let x = &mut pt.x[a..b];
+    let v = &mut pt.v[a..b];
+    let w = &mut pt.w[a..b];
+    let f = &mut pt.f[a..b];
+    let t = &mut pt.t[a..b];
+    let inv_mass = &pt.inv_mass[a..b];
+    let inv_inertia = &pt.inv_inertia[a..b];
+    let touched = &l.touched[a..b];
     // Each particle's values are loaded once into locals and stored once: a store followed by
     // an overlapping wider load of the same vector stalls store forwarding.
-    for p in a..b {
-        let im = pt.inv_mass[p];
+    for j in 0..x.len() {
+        let im = inv_mass[j];
         if im > 0.0 {
             let (fp, tp) = if kick_end {
-                let g = gather(p, l.pairs, l.active, l.out);
-                pt.f[p] = g.0;
-                pt.t[p] = g.1;
+                // load, then store only if set: a swap would be a locked instruction
+                let g = if touched[j].load(Ordering::Relaxed) {
+                    touched[j].store(false, Ordering::Relaxed);
+                    gather(a + j, l.pairs, l.active, l.out)
+                } else {
+                    (Vec3::zeros(), Vec3::zeros())
+                };
+                f[j] = g.0;
+                t[j] = g.1;
                 g
             } else {
-                (pt.f[p], pt.t[p])
+                (f[j], t[j])
             };
             // Half kick v += (F/m + g)·dt/2, ω += T/I·dt/2, in MercuryDPM's order of operations
             // (BaseParticle::integrateBeforeForceComputation); the closing kick of one step and
@@ -634,34 +660,34 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
                 fp * im
             };
             let dv = acc * 0.5 * dt;
-            let mut vp = pt.v[p];
+            let mut vp = v[j];
             if kick_end {
                 vp += dv;
             }
             if drift {
                 vp += dv;
-                let mut xp = pt.x[p] + vp * dt;
+                let mut xp = x[j] + vp * dt;
                 view.domain.wrap(&mut xp);
-                pt.x[p] = xp;
+                x[j] = xp;
                 vmax2 = vmax2.max(vp.norm_squared());
             }
-            pt.v[p] = vp;
+            v[j] = vp;
             if ROT {
-                let dw = tp * pt.inv_inertia[p] * 0.5 * dt;
-                let mut wp = pt.w[p];
+                let dw = tp * inv_inertia[j] * 0.5 * dt;
+                let mut wp = w[j];
                 if kick_end {
                     wp += dw;
                 }
                 if drift {
                     wp += dw;
                 }
-                pt.w[p] = wp;
+                w[j] = wp;
             }
         } else if drift {
-            let vp = pt.v[p];
-            let mut xp = pt.x[p] + vp * dt;
+            let vp = v[j];
+            let mut xp = x[j] + vp * dt;
             view.domain.wrap(&mut xp);
-            pt.x[p] = xp;
+            x[j] = xp;
             vmax2 = vmax2.max(vp.norm_squared());
         }
     }
@@ -703,36 +729,70 @@ unsafe fn pair_pass<L: ContactLaw, const PERIODIC: bool>(
     b: usize,
 ) {
     let pt = view.particles.get();
-    for k in a..b {
+    // Plain slices: their bounds live in registers for the whole loop.
+    let parts = ParticleSlices::of(pt);
+    let (pp, ii) = (&l.pairs.p[a..b], &l.pairs.i[a..b]);
+    let (xi, active, out) = (&mut l.xi[a..b], &mut l.active[a..b], &mut l.out[a..b]);
+    let touched = &l.touched[..];
+    for k in 0..pp.len() {
+        let (p, i) = (pp[k] as usize, ii[k] as usize);
         pair_force::<L, PERIODIC>(
             view.law,
             view.domain,
             view.dt,
-            k,
-            l.pairs,
-            pt,
-            &mut l.xi[k],
-            &mut l.active[k],
-            &mut l.out[k],
+            p,
+            i,
+            &parts,
+            &mut xi[k],
+            &mut active[k],
+            &mut out[k],
         );
+        if active[k] {
+            // only free particles gather (and clear their flag)
+            for q in [p, i] {
+                if parts.inv_mass[q] > 0.0 {
+                    touched[q].store(true, Ordering::Relaxed);
+                }
+            }
+        }
     }
 }
 
-/// Force of pair `k` into its slot; a pair that is not touching forgets its history.
+/// The particle arrays a pair force reads.
+struct ParticleSlices<'a> {
+    x: &'a [Vec3],
+    v: &'a [Vec3],
+    w: &'a [Vec3],
+    radius: &'a [f64],
+    inv_mass: &'a [f64],
+}
+
+impl<'a> ParticleSlices<'a> {
+    fn of(pt: &'a Particles) -> Self {
+        ParticleSlices {
+            x: &pt.x,
+            v: &pt.v,
+            w: &pt.w,
+            radius: &pt.radius,
+            inv_mass: &pt.inv_mass,
+        }
+    }
+}
+
+/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     law: &L,
     domain: &Domain,
     dt: f64,
-    k: usize,
-    pairs: &PairList,
-    pt: &Particles,
+    p: usize,
+    i: usize,
+    pt: &ParticleSlices<'_>,
     xi: &mut Vec3,
     active: &mut bool,
     out: &mut PairForce,
 ) {
-    let (p, i) = (pairs.p[k] as usize, pairs.i[k] as usize);
     let direct = pt.x[p] - pt.x[i];
     let r = if PERIODIC {
         domain.min_image(direct)
