@@ -1,1 +1,121 @@
-fn main() {}
+//! Criterion benchmarks: the pair-force kernel, the pair-list rebuild, one full time step of
+//! MercuryDPM's developed shear state (1 and 2 threads), and the coarse-graining of one save.
+//! Needs `../shared/data` beside the repository. Run: `cargo bench`.
+
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use verdem::case::Case;
+use verdem::cg::fields::{raw_fields, Grid};
+use verdem::cg::kernel::Kernel;
+use verdem::contact::{
+    ContactLaw, LinearSpringDashpot, MercuryLaw, MercurySlidingFriction, PairInput,
+};
+use verdem::engine::{self, Overrides};
+use verdem::sim::Engine;
+use verdem::Vec3;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn developed(threads: usize) -> (Case, Box<dyn Engine>) {
+    let case = Case::load(&root().join("cases/shear_flow_quick.toml")).unwrap();
+    let init = root().join("../shared/data/states/mercury_t143.85.data");
+    let scene = verdem::scene::build(&case, Some(&init)).unwrap();
+    let mut e = engine::build(
+        &case,
+        scene,
+        &Overrides {
+            threads: Some(threads),
+            ..Overrides::default()
+        },
+    );
+    e.advance(1);
+    (case, e)
+}
+
+fn pair_kernel(c: &mut Criterion) {
+    let law: MercuryLaw = verdem::contact::Composed {
+        normal: LinearSpringDashpot {
+            kn: 2e5,
+            gamman: 15.0,
+        },
+        tangential: MercurySlidingFriction {
+            kt: 2e5 * 2.0 / 7.0,
+            gammat: 15.0 * 2.0 / 7.0,
+            mu: 0.3,
+        },
+    };
+    let input = PairInput {
+        r: Vec3::new(0.1, 0.2, 0.97),
+        rad_p: 0.5,
+        rad_i: 0.5,
+        v_p: Vec3::new(0.3, -0.1, -0.2),
+        v_i: Vec3::new(-0.1, 0.0, 0.1),
+        w_p: Vec3::new(1.0, 0.5, -0.2),
+        w_i: Vec3::new(0.0, -0.3, 0.4),
+    };
+    c.bench_function("pair force (kinematics + MercuryDPM law)", |b| {
+        let mut xi = Vec3::new(1e-5, -2e-5, 0.0);
+        b.iter(|| {
+            let k = black_box(&input).kinematics().unwrap();
+            black_box(law.evaluate(&k, &mut xi, 7.192545031528827e-05))
+        })
+    });
+}
+
+fn rebuild(c: &mut Criterion) {
+    let (_, mut e) = developed(1);
+    c.bench_function("pair-list rebuild, developed state", |b| {
+        b.iter(|| e.core_mut().rebuild())
+    });
+}
+
+fn step(c: &mut Criterion) {
+    for threads in [1, 2] {
+        let (_, mut e) = developed(threads);
+        c.bench_function(
+            &format!("1000 steps, developed state, {threads} thread(s)"),
+            |b| b.iter(|| e.advance(1000)),
+        );
+    }
+}
+
+fn coarse_grain(c: &mut Criterion) {
+    let (_, e) = developed(1);
+    let snap = e.core().snapshot();
+    let dir = tempfile::tempdir().unwrap();
+    let (dp, fp) = (dir.path().join("b.data"), dir.path().join("b.fstat"));
+    std::fs::write(&dp, verdem::io::mercury::data_text(&snap)).unwrap();
+    std::fs::write(&fp, verdem::io::mercury::fstat_text(&snap)).unwrap();
+    let data = verdem::io::mercury::read_data(&dp).unwrap();
+    let fstat = verdem::io::mercury::read_fstat(&fp).unwrap();
+    let grid = Grid {
+        z0: 0.0,
+        z1: 22.0,
+        n: 100,
+    };
+    c.bench_function("coarse-graining of one save (100 slices)", |b| {
+        b.iter(|| {
+            black_box(raw_fields(
+                &data,
+                &fstat,
+                &|i| i < 480,
+                &snap.domain,
+                &grid,
+                Kernel::Heaviside { h: 0.22 },
+                1.0,
+            ))
+        })
+    });
+}
+
+criterion_group! {
+    name = benches;
+    // no HTML plots: they would need a font registered with plotters
+    config = Criterion::default().without_plots();
+    targets = pair_kernel, rebuild, step, coarse_grain
+}
+criterion_main!(benches);
