@@ -5,9 +5,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 echo "== system packages"
-# The profile plots label their axes with DejaVu Sans (Debian fonts-dejavu-core).
-if [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ]; then
-  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq fonts-dejavu-core
+# The peers of the cross-runs and timings (Debian lammps, liggghts, with OpenMPI's mpirun) and
+# the font the profile plots label their axes with (fonts-dejavu-core).
+if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command -v mpirun >/dev/null \
+   || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ]; then
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin fonts-dejavu-core >/dev/null
 fi
 
 echo "== formatting and lints"

@@ -5,6 +5,7 @@
 //! read) → [`sim`] (the time step, top to bottom) → [`io`] (MercuryCG `.data`/`.fstat` saves,
 //! checkpoints) and [`diagnostics`].
 
+pub mod bench;
 pub mod case;
 pub mod cg;
 pub mod checkpoint;
@@ -15,6 +16,7 @@ pub mod engine;
 pub mod hash;
 pub mod io;
 pub mod neighbor;
+pub mod peers;
 pub mod run;
 pub mod scene;
 pub mod sim;

@@ -9,7 +9,7 @@ use verdem::case::Case;
 use verdem::cg::{self, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
 use verdem::run::{self, RunOptions};
-use verdem::{checkpoint, hash, scene};
+use verdem::{bench, checkpoint, hash, scene};
 
 #[derive(Parser)]
 #[command(
@@ -89,6 +89,31 @@ enum Command {
         /// Blocks of saves for the standard errors.
         #[arg(long, default_value_t = 10)]
         blocks: usize,
+    },
+    /// Time verdem against the installed LAMMPS and LIGGGHTS on the same case and state.
+    Bench {
+        /// Case file (default: cases/shear_flow_quick.toml).
+        case: Option<PathBuf>,
+        /// State to start from (default: MercuryDPM's developed state).
+        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        from: PathBuf,
+        #[arg(long, default_value_t = 20_000)]
+        steps: u64,
+        /// verdem thread counts.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Peers to run (none: --peers '').
+        #[arg(long, value_delimiter = ',', default_value = "lammps,liggghts")]
+        peers: Vec<String>,
+        /// MPI ranks for the peers.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        np: Vec<usize>,
+        /// Alternating rounds.
+        #[arg(long, default_value_t = 3)]
+        rounds: usize,
+        /// Where the table (bench.md, bench.csv) and the peers' inputs go.
+        #[arg(long, default_value = "out/bench")]
+        out: PathBuf,
     },
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash {
@@ -269,6 +294,56 @@ fn real_main() -> anyhow::Result<()> {
             o.blocks = blocks;
             let (_, report) = cg::write_all(&base, &o)?;
             print!("{report}");
+        }
+        Command::Bench {
+            case,
+            from,
+            steps,
+            threads,
+            peers,
+            np,
+            rounds,
+            out,
+        } => {
+            let case =
+                Case::load(&case.unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml")))?;
+            let mut configs: Vec<bench::Config> = threads
+                .iter()
+                .map(|&t| bench::Config::Verdem { threads: t })
+                .collect();
+            for name in peers.iter().filter(|p| !p.is_empty()) {
+                let peer = match name.as_str() {
+                    "lammps" => verdem::peers::Peer::Lammps,
+                    "liggghts" => verdem::peers::Peer::Liggghts,
+                    other => anyhow::bail!("--peers: unknown peer {other:?} (lammps, liggghts)"),
+                };
+                configs.extend(np.iter().map(|&n| bench::Config::Peer { peer, np: n }));
+            }
+            let measured = bench::run(&case, &from, steps, &configs, rounds, &out)?;
+            let particles = scene::build(&case, Some(&from))?.particles.len();
+            let md = bench::markdown(&measured, particles);
+            let cpu = std::fs::read_to_string("/proc/cpuinfo")
+                .ok()
+                .and_then(|c| {
+                    c.lines()
+                        .find(|l| l.starts_with("model name"))
+                        .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+                })
+                .unwrap_or_default();
+            let header = format!(
+                "{steps} steps of {} from {}, {rounds} alternating rounds, {} cores ({cpu}), no file output in the timed region
+
+",
+                case.name,
+                from.display(),
+                std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0)
+            );
+            print!("{header}{md}");
+            verdem::io::atomic::write(&out.join("bench.md"), (header + &md).as_bytes())?;
+            verdem::io::atomic::write(
+                &out.join("bench.csv"),
+                bench::csv(&measured, particles).as_bytes(),
+            )?;
         }
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;
