@@ -22,6 +22,7 @@ pub mod scene;
 pub mod sim;
 pub mod state;
 pub mod team;
+pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.
 pub type Vec3 = nalgebra::Vector3<f64>;

@@ -115,6 +115,12 @@ enum Command {
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
     },
+    /// Run the verification cases and print expected, measured, tolerance and PASS/FAIL.
+    Verify {
+        /// The binary-collision case.
+        #[arg(long, default_value = "cases/verify/binary_collision.toml")]
+        collision: PathBuf,
+    },
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash {
         #[command(flatten)]
@@ -344,6 +350,15 @@ fn real_main() -> anyhow::Result<()> {
                 &out.join("bench.csv"),
                 bench::csv(&measured, particles).as_bytes(),
             )?;
+        }
+        Command::Verify { collision } => {
+            let rows = verdem::verify::binary_collisions(&Case::load(&collision)?)?;
+            print!("{}", verdem::verify::table(&rows));
+            let failed = rows.iter().filter(|r| !r.pass).count();
+            println!("{} passed, {failed} failed", rows.len() - failed);
+            if failed > 0 {
+                std::process::exit(1);
+            }
         }
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;
