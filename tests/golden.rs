@@ -24,7 +24,7 @@ fn short_run(
     init: Option<&std::path::Path>,
     steps: u64,
     save_every: u64,
-) -> (String, String, String, String) {
+) -> (String, String, String, String, String) {
     let case = quick_case();
     let mut outputs = Vec::new();
     for threads in [1, 2] {
@@ -58,15 +58,52 @@ fn short_run(
                 .join("\n")
         };
         let diag = std::fs::read_to_string(run::diagnostics_path(dir.path(), "g")).unwrap();
-        outputs.push((s.hash, diag, head("data", 4), head("fstat", 9)));
+        outputs.push((
+            s.hash,
+            diag,
+            head("data", 4),
+            head("fstat", 9),
+            profiles(&dir.path().join("g")),
+        ));
     }
     assert_eq!(outputs[0], outputs[1], "1 and 2 threads differ");
     outputs.remove(0)
 }
 
+/// Coarse-grained profiles of all saves (20 Heaviside slices, 2 blocks), every number rounded to
+/// 6 significant digits.
+fn profiles(base: &std::path::Path) -> String {
+    let o = verdem::cg::CgOptions {
+        from: Some(0),
+        to: None,
+        slices: 20,
+        kernel: verdem::cg::KernelChoice::Heaviside,
+        width: None,
+        walls: 480,
+        density: 1.0,
+        periodic: [true, true, false],
+        blocks: 2,
+    };
+    let p = verdem::cg::coarse_grain(&verdem::cg::Series::find(base).unwrap(), &o).unwrap();
+    verdem::cg::csv(&p)
+        .lines()
+        .map(|l| {
+            l.split(',')
+                .map(|v| {
+                    v.parse::<f64>()
+                        .map(|x| format!("{x:.5e}"))
+                        .unwrap_or_else(|_| v.to_string())
+                })
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 fn check(tag: &str, init: Option<&std::path::Path>, what: &str) {
     let (steps, every) = (4000, 1000);
-    let (hash, diag, data, fstat) = short_run(init, steps, every);
+    let (hash, diag, data, fstat, cg) = short_run(init, steps, every);
     let how = format!(
         "cases/shear_flow_quick.toml {what}, {steps} steps, a save every {every}, 1 and 2 threads"
     );
@@ -78,6 +115,13 @@ fn check(tag: &str, init: Option<&std::path::Path>, what: &str) {
     golden(&format!("{tag}_diagnostics"), &how, diag);
     golden(&format!("{tag}_data_head"), &how, data);
     golden(&format!("{tag}_fstat_head"), &how, fstat);
+    golden(
+        &format!("{tag}_profiles"),
+        &format!(
+            "{how}; `verdem cg` of all saves, 20 Heaviside slices, 2 blocks, rounded to 6 digits"
+        ),
+        cg,
+    );
 }
 
 #[test]
