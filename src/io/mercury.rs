@@ -153,12 +153,7 @@ pub struct DataFile {
 /// Reads a MercuryCG `.data` file; any precision is accepted. Errors name the file and line:
 /// wrong column count, a header count that does not match the lines, a non-number, NaN.
 pub fn read_data(path: &Path) -> Result<DataFile, FormatError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FormatError {
-        file: file.clone(),
-        line: 0,
-        msg: format!("cannot read: {e}"),
-    })?;
+    let (file, text) = super::read_text(path)?;
     let mut lines = text.lines().enumerate();
     let mut nums = Vec::new();
     let (_, head) = lines.next().ok_or_else(|| FormatError {
@@ -250,12 +245,7 @@ pub struct FstatFile {
 
 /// Reads an `.fstat` file (three `#` lines, then 16 columns per contact line).
 pub fn read_fstat(path: &Path) -> Result<FstatFile, FormatError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FormatError {
-        file: file.clone(),
-        line: 0,
-        msg: format!("cannot read: {e}"),
-    })?;
+    let (file, text) = super::read_text(path)?;
     let mut out = FstatFile {
         time: f64::NAN,
         rows: Vec::new(),

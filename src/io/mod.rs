@@ -26,6 +26,17 @@ pub fn fmt_f64(out: &mut String, v: f64) {
     }
 }
 
+/// Reads a text file; returns its name (for messages) and its text.
+pub fn read_text(path: &std::path::Path) -> Result<(String, String), FormatError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| FormatError {
+        file: file.clone(),
+        line: 0,
+        msg: format!("cannot read: {e}"),
+    })?;
+    Ok((file, text))
+}
+
 /// Parses whitespace-separated numbers of one line, naming file and line on failure; NaN and
 /// infinities are rejected.
 pub fn parse_numbers(

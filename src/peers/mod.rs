@@ -113,6 +113,18 @@ pub fn input_script(peer: Peer, case: &Case, data: &str, steps: u64) -> anyhow::
         .iter()
         .map(|p| if *p { "p " } else { "f " })
         .collect();
+    // The same in both codes: groups by type; walls moved rigidly, free spheres integrated.
+    let groups = "group           free   type 1\ngroup           bottom type 2\ngroup           top    type 3\n";
+    let motion = format!(
+        "timestep        {dt:?}\n\
+velocity        bottom set {vb:?} 0 0 units box\n\
+velocity        top    set {vt:?} 0 0 units box\n\
+fix             wbot bottom move linear {vb:?} 0 0\n\
+fix             wtop top    move linear {vt:?} 0 0\n\
+fix             integ free nve/sphere\n\
+thermo          {steps}\n\
+run             {steps}\n"
+    );
     Ok(match peer {
         Peer::Lammps => format!(
             "{head}\
@@ -121,22 +133,12 @@ atom_style      sphere\n\
 boundary        {periodic}\n\
 comm_modify     vel yes\n\
 read_data       {data}\n\
-group           free   type 1\n\
-group           bottom type 2\n\
-group           top    type 3\n\
-# absolute damping: 'damping velocity' (LAMMPS pair_style granular); eta_t = {gt:?}/{gn:?} * eta_n\n\
+{groups}# absolute damping: 'damping velocity' (LAMMPS pair_style granular); eta_t = {gt:?}/{gn:?} * eta_n\n\
 pair_style      granular\n\
 pair_coeff      * * hooke {kn:?} {gn:?} tangential linear_history {kt:?} {xgt:?} {mu:?} damping velocity\n\
 neighbor        {skin:?} bin\n\
 neigh_modify    delay 0 every 1 check yes exclude type 2 2 exclude type 3 3 exclude type 2 3\n\
-timestep        {dt:?}\n\
-velocity        bottom set {vb:?} 0 0 units box\n\
-velocity        top    set {vt:?} 0 0 units box\n\
-fix             wbot bottom move linear {vb:?} 0 0\n\
-fix             wtop top    move linear {vt:?} 0 0\n\
-fix             integ free nve/sphere\n\
-thermo          {steps}\n\
-run             {steps}\n",
+{motion}",
             kn = c.kn,
             gn = c.gamman,
             kt = c.kt,
@@ -155,24 +157,14 @@ boundary        {periodic}\n\
 newton          off\n\
 communicate     single vel yes\n\
 read_data       {data}\n\
-group           free   type 1\n\
-group           bottom type 2\n\
-group           top    type 3\n\
-{}{}{}{}{}\
+{groups}{}{}{}{}{}\
 # absolute damping (gamman_abs, gammat_abs), not scaled by the effective mass\n\
 pair_style      gran model hooke/stiffness tangential history absolute_damping on\n\
 pair_coeff      * *\n\
 # contact_distance_factor 1.01: reset a tangential spring when its contact ends\n\
 neighbor        {skin:?} bin\n\
 neigh_modify    delay 0 every 1 check yes contact_distance_factor 1.01 exclude type 2 2 exclude type 3 3 exclude type 2 3\n\
-timestep        {dt:?}\n\
-velocity        bottom set {vb:?} 0 0 units box\n\
-velocity        top    set {vt:?} 0 0 units box\n\
-fix             wbot bottom move linear {vb:?} 0 0\n\
-fix             wtop top    move linear {vt:?} 0 0\n\
-fix             integ free nve/sphere\n\
-thermo          {steps}\n\
-run             {steps}\n",
+{motion}",
                 m("kn", c.kn),
                 m("kt", c.kt),
                 m("gamman_abs", c.gamman),
