@@ -28,8 +28,6 @@ pub struct PairList {
     pub p: Vec<u32>,
     /// Memory index of the higher-id particle of each pair (I).
     pub i: Vec<u32>,
-    /// Pairs owned by memory index a: `owner_start[a]..owner_start[a+1]`.
-    pub owner_start: Vec<u32>,
     /// `adj[adj_start[a]..adj_start[a+1]]` are particle `a`'s pair slots, sorted by partner id;
     /// each entry is `slot << 1 | role`, role 0 when `a` is P and 1 when `a` is I.
     pub adj_start: Vec<u32>,
@@ -92,8 +90,6 @@ impl NeighborBuilder {
         let n = x.len();
         list.p.clear();
         list.i.clear();
-        list.owner_start.clear();
-        list.owner_start.push(0);
         let skin = self.skin;
         let accept = |a: usize, b: usize| {
             let cut = radius[a] + radius[b] + skin;
@@ -116,7 +112,6 @@ impl NeighborBuilder {
                             push(list, a, b);
                         }
                     }
-                    list.owner_start.push(list.p.len() as u32);
                 }
             }
             Search::Cells => {
@@ -148,7 +143,6 @@ impl NeighborBuilder {
                     for &b in &partners {
                         push(list, a, b as usize);
                     }
-                    list.owner_start.push(list.p.len() as u32);
                 }
                 self.partners = partners;
             }
@@ -314,7 +308,6 @@ mod tests {
             &id,
             |_, _| true,
         );
-        assert_eq!(*cells.owner_start.last().unwrap() as usize, cells.p.len());
         assert!(!cells.p.is_empty());
         assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
         assert!((0..cells.p.len()).all(|k| ids[cells.p[k] as usize] < ids[cells.i[k] as usize]));

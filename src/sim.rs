@@ -95,6 +95,9 @@ pub struct Core {
     /// Set by the pair pass for both particles of every contact, read and cleared by the next
     /// particle pass: a particle without contacts skips the gather (its sum is exactly zero).
     touched: Vec<AtomicBool>,
+    /// Whether each particle (memory order) was within a skin of a periodic face at the last
+    /// build; the others cannot cross one before the next build and skip the wrap.
+    near_face: Vec<bool>,
     builder: NeighborBuilder,
     scratch: Scratch,
 }
@@ -111,6 +114,13 @@ struct Scratch {
     fill: Vec<u32>,
     pair_keys: Vec<(bool, f64, u32)>,
     particle_ranges: Vec<(usize, usize)>,
+    /// Relative speed of each thread (work per second), learnt from the measured busy times
+    /// between builds; the shares follow it. Shares never change a bit of the results.
+    speed: Vec<f64>,
+    /// Total weight of each thread's share at the last build.
+    range_weight: Vec<u64>,
+    /// Each thread's pairs, before they are split into interior and boundary parts.
+    pair_bounds: Vec<(usize, usize)>,
     /// Each thread's pairs `(a, m, b)`: interior pairs `a..m`, then pairs across a periodic
     /// boundary `m..b`, each part sorted by gap.
     pair_ranges: Vec<(usize, usize, usize)>,
@@ -150,9 +160,11 @@ impl Core {
             threads,
             times: StageTimes::default(),
             touched: Vec::new(),
+            near_face: Vec::new(),
             builder,
             scratch: Scratch {
                 particle_ranges: vec![(0, 0); threads],
+                speed: vec![1.0; threads],
                 ..Scratch::default()
             },
         }
@@ -175,13 +187,14 @@ impl Core {
             scratch: &mut self.scratch,
             times: &mut self.times,
             touched: &mut self.touched,
+            near_face: &mut self.near_face,
         }
     }
 
     /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
     pub fn rebuild(&mut self) {
         let domain = self.domain.clone();
-        self.list_state().rebuild(&domain);
+        self.list_state().rebuild(&domain, &[]);
         self.moved_bound = 0.0;
     }
 
@@ -292,7 +305,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if !self.core.forces_ready {
             self.initial_forces();
         }
-        if self.core.pairs.owner_start.is_empty() {
+        if self.core.pairs.adj_start.is_empty() {
             self.core.rebuild();
         }
         match (L::TANGENTIAL, self.core.gravity.is_some()) {
@@ -354,6 +367,7 @@ impl<L: ContactLaw> Simulation<L> {
         let threads = core.threads;
         let barrier = SpinBarrier::new(threads);
         let vmax2: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
+        let busy: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
         let skin = core.skin();
         let bound0 = core.moved_bound;
         let domain = core.domain.clone();
@@ -378,17 +392,21 @@ impl<L: ContactLaw> Simulation<L> {
                 }
             };
             let mut bound = bound0;
+            // this thread's compute time since the last build (ns), for the load balance
+            let mut busy_local = 0u64;
             // Ends of the live prefixes of this thread's interior and boundary pairs.
             let mut live: Option<(usize, usize)> = None;
             for s in 0..steps {
                 // SAFETY (all blocks below): phases are separated by barriers; in each phase a
                 // thread writes only its own particle range or pair range, and a rebuild runs on
                 // thread 0 alone between two barriers.
+                let t_start = Instant::now();
                 let v2 = unsafe {
                     let l = list.get();
                     let (a, b) = l.scratch.particle_ranges[tid];
                     particle_pass::<L, ROT, GRAV>(&view, l, a, b, s > 0, true)
                 };
+                busy_local += t_start.elapsed().as_nanos() as u64;
                 vmax2[tid].store(v2.to_bits(), Ordering::Relaxed);
                 lap(&mut local.integrate);
                 barrier.wait();
@@ -402,8 +420,11 @@ impl<L: ContactLaw> Simulation<L> {
                 if bound > 0.5 * skin {
                     bound = 0.0;
                     live = None;
+                    busy[tid].store(busy_local, Ordering::Relaxed);
+                    busy_local = 0;
+                    barrier.wait();
                     if tid == 0 {
-                        unsafe { list.get().rebuild(view.domain) };
+                        unsafe { list.get().rebuild(view.domain, &busy) };
                     }
                     barrier.wait();
                     lap(&mut local.neighbor);
@@ -423,8 +444,10 @@ impl<L: ContactLaw> Simulation<L> {
                         lb += 1;
                     }
                     live = Some((li, lb));
+                    let t_start = Instant::now();
                     pair_pass::<L, false>(&view, l, a, li);
                     pair_pass::<L, true>(&view, l, m, lb);
+                    busy_local += t_start.elapsed().as_nanos() as u64;
                 }
                 lap(&mut local.forces);
                 barrier.wait();
@@ -473,6 +496,7 @@ struct ListState<'a> {
     scratch: &'a mut Scratch,
     times: &'a mut StageTimes,
     touched: &'a mut Vec<AtomicBool>,
+    near_face: &'a mut Vec<bool>,
 }
 
 fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
@@ -483,8 +507,9 @@ fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
 
 impl ListState<'_> {
     /// Re-orders the particles by cell, rebuilds the pair list, carries every contact's history
-    /// over (matched by original ids), and re-balances the threads' ranges.
-    fn rebuild(&mut self, domain: &Domain) {
+    /// over (matched by original ids), and re-balances the threads' ranges; `busy` holds each
+    /// thread's compute time (ns) since the last build, when known.
+    fn rebuild(&mut self, domain: &Domain, busy: &[AtomicU64]) {
         let t0 = Instant::now();
         let s = &mut *self.scratch;
         // History of the contacts, by original ids.
@@ -523,14 +548,30 @@ impl ListState<'_> {
             .resize_with(pt.len(), || AtomicBool::new(false));
         // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
-        let owner = &self.pairs.owner_start;
+        let ns = |t: usize| busy[t].load(Ordering::Relaxed) as f64;
+        if busy.len() == threads
+            && s.range_weight.len() == threads
+            && (0..threads).all(|t| ns(t) > 0.0)
+        {
+            let measured = |t: usize| s.range_weight[t] as f64 / ns(t);
+            let mean = (0..threads).map(measured).sum::<f64>() / threads as f64;
+            for t in 0..threads {
+                s.speed[t] = 0.5 * s.speed[t] + 0.5 * measured(t) / mean;
+            }
+        }
         let inv_mass = &pt.inv_mass;
-        balanced_ranges(
-            pt.len(),
-            threads,
-            |a| (if inv_mass[a] > 0.0 { 8 } else { 2 }) + 2 * (owner[a + 1] - owner[a]) as u64,
-            &mut s.particle_ranges,
-        );
+        // Each pass is balanced on its own (every pass ends at a barrier): particles by their
+        // cost, pairs by count; the pair list is in owner (memory, so space) order, so a
+        // thread's pairs lie mostly among its own particles.
+        let weight = |a: usize| if inv_mass[a] > 0.0 { 8 } else { 2 };
+        balanced_ranges(pt.len(), &s.speed, weight, &mut s.particle_ranges);
+        balanced_ranges(n_pairs, &s.speed, |_| 2, &mut s.pair_bounds);
+        s.range_weight.clear();
+        s.range_weight.extend((0..threads).map(|t| {
+            let (a, b) = s.particle_ranges[t];
+            let (pa, pb) = s.pair_bounds[t];
+            (a..b).map(weight).sum::<u64>() + 2 * (pb - pa) as u64
+        }));
         // Within a share, interior pairs (no periodic image needed until the next build) come
         // first, then the others; each part sorted by gap, so that a step visits only the
         // prefix of pairs whose gap the particles can have closed (see `live`).
@@ -541,6 +582,8 @@ impl ListState<'_> {
                     || (pt.x[a][k] >= domain.lo[k] + skin && pt.x[a][k] < domain.hi[k] - skin)
             })
         };
+        self.near_face.clear();
+        self.near_face.extend((0..pt.len()).map(|a| !interior(a)));
         s.pair_keys.clear();
         for k in 0..n_pairs {
             let (p, i) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
@@ -555,8 +598,7 @@ impl ListState<'_> {
                 .push((!plain, r.norm() - (pt.radius[p] + pt.radius[i]), k as u32));
         }
         s.pair_ranges.clear();
-        for &(a, b) in &s.particle_ranges {
-            let (pa, pb) = (owner[a] as usize, owner[b] as usize);
+        for &(pa, pb) in &s.pair_bounds {
             let part = &mut s.pair_keys[pa..pb];
             part.sort_unstable_by(|x, y| {
                 x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2))
@@ -632,14 +674,39 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     let inv_mass = &pt.inv_mass[a..b];
     let inv_inertia = &pt.inv_inertia[a..b];
     let touched = &l.touched[a..b];
+    let near_face = &l.near_face[a..b];
     // Each particle's values are loaded once into locals and stored once: a store followed by
     // an overlapping wider load of the same vector stalls store forwarding.
     for j in 0..x.len() {
         let im = inv_mass[j];
+        let drift_to = |vp: Vec3, xj: Vec3| {
+            let mut xp = xj + vp * dt;
+            if near_face[j] {
+                view.domain.wrap(&mut xp);
+            }
+            xp
+        };
         if im > 0.0 {
+            // load, then store only if set: a swap would be a locked instruction
+            let contact = kick_end && touched[j].load(Ordering::Relaxed);
+            if !GRAV && kick_end && !contact {
+                // Free flight: F = T = 0 exactly, so both half kicks add +0; (v + 0) + 0 = v + 0
+                // bit for bit, which this path computes once.
+                f[j] = Vec3::zeros();
+                t[j] = Vec3::zeros();
+                let vp = v[j] + Vec3::zeros();
+                if drift {
+                    x[j] = drift_to(vp, x[j]);
+                    vmax2 = vmax2.max(vp.norm_squared());
+                }
+                v[j] = vp;
+                if ROT {
+                    w[j] += Vec3::zeros();
+                }
+                continue;
+            }
             let (fp, tp) = if kick_end {
-                // load, then store only if set: a swap would be a locked instruction
-                let g = if touched[j].load(Ordering::Relaxed) {
+                let g = if contact {
                     touched[j].store(false, Ordering::Relaxed);
                     gather(a + j, l.pairs, l.active, l.out)
                 } else {
@@ -666,9 +733,7 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
             }
             if drift {
                 vp += dv;
-                let mut xp = x[j] + vp * dt;
-                view.domain.wrap(&mut xp);
-                x[j] = xp;
+                x[j] = drift_to(vp, x[j]);
                 vmax2 = vmax2.max(vp.norm_squared());
             }
             v[j] = vp;
@@ -685,9 +750,7 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
             }
         } else if drift {
             let vp = v[j];
-            let mut xp = x[j] + vp * dt;
-            view.domain.wrap(&mut xp);
-            x[j] = xp;
+            x[j] = drift_to(vp, x[j]);
             vmax2 = vmax2.max(vp.norm_squared());
         }
     }

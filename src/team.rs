@@ -76,20 +76,25 @@ impl<T> Shared<T> {
     }
 }
 
-/// Splits `0..n` into `parts` contiguous ranges of nearly equal total `weight(k)`.
+/// Splits `0..n` into one contiguous range per entry of `speeds`, the total `weight(k)` of each
+/// range proportional to its speed (equal speeds: equal weights).
 pub fn balanced_ranges(
     n: usize,
-    parts: usize,
+    speeds: &[f64],
     weight: impl Fn(usize) -> u64,
     out: &mut Vec<(usize, usize)>,
 ) {
     out.clear();
+    let parts = speeds.len();
     let total: u64 = (0..n).map(&weight).sum();
+    let all: f64 = speeds.iter().sum();
     let mut start = 0;
     let mut acc = 0u64;
     let mut k = 0;
+    let mut cumulative = 0.0;
     for part in 0..parts {
-        let target = total * (part as u64 + 1) / parts as u64;
+        cumulative += speeds[part];
+        let target = (total as f64 * cumulative / all) as u64;
         while k < n && (acc < target || part + 1 == parts) {
             acc += weight(k);
             k += 1;
@@ -106,7 +111,7 @@ mod tests {
     #[test]
     fn balanced_ranges_cover_everything_once() {
         let mut r = Vec::new();
-        balanced_ranges(10, 3, |k| if k < 5 { 1 } else { 3 }, &mut r);
+        balanced_ranges(10, &[1.0; 3], |k| if k < 5 { 1 } else { 3 }, &mut r);
         assert_eq!(r.first().unwrap().0, 0);
         assert_eq!(r.last().unwrap().1, 10);
         assert!(r.windows(2).all(|w| w[0].1 == w[1].0));
@@ -115,6 +120,9 @@ mod tests {
             .map(|&(a, b)| (a..b).map(|k| if k < 5 { 1 } else { 3 }).sum())
             .collect();
         assert!(w.iter().all(|&x| (6..=9).contains(&x)), "{w:?}");
+        // a part twice as fast gets about twice the weight
+        balanced_ranges(100, &[2.0, 1.0], |_| 1, &mut r);
+        assert!(matches!(r[0], (0, 66..=67)) && r[1].0 == r[0].1 && r[1].1 == 100, "{r:?}");
     }
 
     #[test]
