@@ -74,12 +74,6 @@ impl Domain {
             }
         }
     }
-
-    /// Volume of the box.
-    pub fn volume(&self) -> f64 {
-        let l = self.lengths();
-        l.x * l.y * l.z
-    }
 }
 
 #[cfg(test)]

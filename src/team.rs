@@ -70,10 +70,6 @@ impl<T> Shared<T> {
     pub unsafe fn get(&self) -> &mut T {
         &mut *self.0.get()
     }
-
-    pub fn into_inner(self) -> T {
-        self.0.into_inner()
-    }
 }
 
 /// Splits `0..n` into one contiguous range per entry of `speeds`, the total `weight(k)` of each
@@ -122,7 +118,10 @@ mod tests {
         assert!(w.iter().all(|&x| (6..=9).contains(&x)), "{w:?}");
         // a part twice as fast gets about twice the weight
         balanced_ranges(100, &[2.0, 1.0], |_| 1, &mut r);
-        assert!(matches!(r[0], (0, 66..=67)) && r[1].0 == r[0].1 && r[1].1 == 100, "{r:?}");
+        assert!(
+            matches!(r[0], (0, 66..=67)) && r[1].0 == r[0].1 && r[1].1 == 100,
+            "{r:?}"
+        );
     }
 
     #[test]
