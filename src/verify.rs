@@ -54,12 +54,23 @@ pub struct Measured {
 
 /// Simulates one head-on collision at relative speed `v0` with `dt = tc_ff / per_tc`.
 pub fn collide(base: &Case, v0: f64, wall: bool, per_tc: f64) -> anyhow::Result<Measured> {
+    collide_with_phase(base, v0, wall, per_tc, 0.5)
+}
+
+/// As [`collide`], with the first touch `phase` ∈ [0, 1) of a step into the step.
+pub fn collide_with_phase(
+    base: &Case,
+    v0: f64,
+    wall: bool,
+    per_tc: f64,
+    phase: f64,
+) -> anyhow::Result<Measured> {
     let mut case = base.clone();
     case.run.dt = None;
     case.run.steps_per_collision = Some(per_tc);
     let dt = case.dt();
     // start a little apart, so the contact begins within a few steps at any speed
-    let gap = 2.5 * v0 * dt;
+    let gap = (2.0 + phase) * v0 * dt;
     let Scene::Spheres { sphere } = &mut case.scene else {
         anyhow::bail!(
             "{}: the binary collision case needs a spheres scene",
@@ -144,24 +155,31 @@ pub fn binary_collisions(case: &Case) -> anyhow::Result<Vec<Row>> {
                 2e-3,
             ));
         }
-        // convergence of the restitution error in dt
+        // Convergence of the restitution error in dt. The dashpot sees the half-step velocity
+        // v_(n+1/2) (MercuryDPM's scheme, also LAMMPS' nve/sphere), a lag of dt/2 in the
+        // dissipation: the expected order is 1, not velocity Verlet's 2 for conservative
+        // forces. Where the contact starts and ends within a step adds an error that
+        // oscillates with tc/dt; it is averaged out over 8 onset phases.
         let steps = [10.0, 20.0, 50.0, 100.0, 200.0, 400.0];
         let mut pts = Vec::new();
         for n in steps {
-            let got = collide(case, 1.0, wall, n)?;
+            let mut mean = 0.0;
+            for k in 0..8 {
+                mean += collide_with_phase(case, 1.0, wall, n, k as f64 / 8.0)?.e / 8.0;
+            }
             pts.push((
                 (1.0 / n).ln(),
-                ((got.e - cf.e) / cf.e).abs().max(1e-300).ln(),
+                ((mean - cf.e) / cf.e).abs().max(1e-300).ln(),
             ));
         }
         let order = slope(&pts);
         rows.push(Row {
             case: format!("{label} v0=1 dt=tc/10..tc/400"),
             quantity: "order of the restitution error in dt".into(),
-            expected: 2.0,
+            expected: 1.0,
             measured: order,
-            tolerance: 0.5,
-            pass: (order - 2.0).abs() <= 0.5,
+            tolerance: 0.25,
+            pass: (order - 1.0).abs() <= 0.25,
         });
     }
     Ok(rows)
