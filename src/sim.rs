@@ -305,9 +305,6 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if !self.core.forces_ready {
             self.initial_forces();
         }
-        if self.core.pairs.adj_start.is_empty() {
-            self.core.rebuild();
-        }
         match (L::TANGENTIAL, self.core.gravity.is_some()) {
             (true, false) => self.run::<true, false>(steps),
             (true, true) => self.run::<true, true>(steps),

@@ -90,20 +90,16 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         )
     };
     // Standard errors of the core means, from the same blocks of saves as the profiles.
-    let block_core = |f: &dyn Fn(&super::fields::Derived) -> f64| -> f64 {
-        let n = p.per_save.len();
-        let vals: Vec<f64> = (0..blocks)
-            .map(|b| {
-                let d = super::fields::derive(&super::average(
-                    &p.per_save[b * n / blocks..(b + 1) * n / blocks],
-                ));
-                core.clone().map(|k| f(&d[k])).sum::<f64>() / core.len() as f64
-            })
+    let block_core = |f: &dyn Fn(&[f64]) -> f64| -> f64 {
+        let vals: Vec<f64> = p
+            .block_columns
+            .iter()
+            .map(|b| core.clone().map(|k| f(&b[k])).sum::<f64>() / core.len() as f64)
             .collect();
         standard_error(&vals)
     };
-    let tau_se = block_core(&|d| d.shear);
-    let zz_core_se = block_core(&|d| d.kinetic[(2, 2)] + d.contact[(2, 2)]);
+    let tau_se = block_core(&|c| c[col("shear_xz")]);
+    let zz_core_se = block_core(&|c| c[col("kin_zz")] + c[col("con_zz")]);
     for (label, g, sign) in [("top", 1usize, 1.0), ("bottom", 0usize, -1.0)] {
         let (fx, fx_se) = per_block(&|s| sign * p.wall_force[s][g].x / area);
         let (fz, fz_se) = per_block(&|s| sign * p.wall_force[s][g].z / area);

@@ -108,6 +108,8 @@ pub struct Profiles {
     pub blocks: usize,
     /// Time-averaged derived fields.
     pub mean: Vec<Derived>,
+    /// Per block of saves, per grid point: the [`columns`] derived from the block's average.
+    pub block_columns: Vec<Vec<Vec<f64>>>,
     /// Standard error of each column of [`columns`], per grid point.
     pub se: Vec<Vec<f64>>,
     /// Per save: the raw fields (for the checks).
@@ -242,13 +244,11 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.radius.powi(3))
         .sum();
     let core = core_range(&grid);
+    let derived: Vec<Vec<Derived>> = per_save.iter().map(derive).collect();
     let series_of = |f: &dyn Fn(&Derived) -> f64| -> Vec<f64> {
-        per_save
+        derived
             .iter()
-            .map(|raw| {
-                let d = derive(raw);
-                core.clone().map(|k| f(&d[k])).sum::<f64>() / core.len() as f64
-            })
+            .map(|d| core.clone().map(|k| f(&d[k])).sum::<f64>() / core.len() as f64)
             .collect()
     };
     let tau_shear = integrated_autocorrelation(&series_of(&|d| d.shear));
@@ -258,6 +258,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         kernel,
         saves,
         blocks,
+        block_columns: block_cols,
         mean,
         se,
         per_save,
