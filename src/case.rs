@@ -123,8 +123,48 @@ pub struct Material {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tangential {
-    /// MercuryDPM's sliding friction (the benchmark default).
+    /// MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring +
+    /// dashpot.
     Mercury,
+    /// LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms.
+    LammpsHookeHistory,
+    /// LAMMPS `granular … tangential linear_history`: project and rescale, then increment.
+    LammpsGranular,
+    /// LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while
+    /// sliding.
+    Liggghts,
+    /// Yade's first-order rotation of the spring with the objective slip.
+    Yade,
+    /// Cundall & Strack 1979: no frame update at all.
+    Cundall,
+    /// The objective reference law: exact rotation with the contact frame, objective slip.
+    Objective,
+}
+
+impl Tangential {
+    /// Every convention, in the order of the verification table.
+    pub const ALL: [Tangential; 7] = [
+        Tangential::Mercury,
+        Tangential::LammpsHookeHistory,
+        Tangential::LammpsGranular,
+        Tangential::Liggghts,
+        Tangential::Yade,
+        Tangential::Cundall,
+        Tangential::Objective,
+    ];
+
+    /// The name used in case files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tangential::Mercury => "mercury",
+            Tangential::LammpsHookeHistory => "lammps-hooke-history",
+            Tangential::LammpsGranular => "lammps-granular",
+            Tangential::Liggghts => "liggghts",
+            Tangential::Yade => "yade",
+            Tangential::Cundall => "cundall",
+            Tangential::Objective => "objective",
+        }
+    }
 }
 
 /// `[contact]`: the contact law.
@@ -187,6 +227,10 @@ pub struct SphereSpec {
     pub v: [f64; 3],
     #[serde(default)]
     pub w: [f64; 3],
+    /// Radius (length; default half the material diameter). A fixed sphere of large radius
+    /// stands in for a flat wall.
+    #[serde(default)]
+    pub radius: Option<f64>,
     /// Moved with its prescribed velocity, never integrated (infinite mass).
     #[serde(default)]
     pub fixed: bool,
@@ -343,6 +387,11 @@ impl Case {
             Scene::Spheres { sphere } => {
                 if sphere.is_empty() {
                     return Err(err("scene", "sphere", "needs at least one sphere".into()));
+                }
+                for s in sphere {
+                    if let Some(r) = s.radius {
+                        positive("scene", "radius", r)?;
+                    }
                 }
             }
         }

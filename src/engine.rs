@@ -1,9 +1,13 @@
 //! Builds a simulation from a case: the contact law is composed here, once, from the parts the
-//! case switches on (friction or not, clipped normal force or not).
+//! case switches on (friction or not, tangential convention, clipped normal force or not).
 
-use crate::case::{Case, Tangential};
+use crate::case::{self, Case, Tangential};
 use crate::contact::normal::Clipped;
-use crate::contact::{Composed, Frictionless, LinearSpringDashpot, MercurySlidingFriction};
+use crate::contact::{
+    Composed, ContactLaw, Cundall1979, Frictionless, LammpsGranular, LammpsHookeHistory, Liggghts,
+    LinearSpringDashpot, MercurySlidingFriction, NormalModel, Objective, TangentialModel,
+    YadeApprox,
+};
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
 use crate::sim::{Core, Engine, Simulation};
@@ -15,6 +19,65 @@ pub struct Overrides {
     pub threads: Option<usize>,
     pub skin: Option<f64>,
     pub cell: Option<f64>,
+}
+
+/// Something done with the contact law of a case, whichever concrete type it composes to.
+pub trait LawVisitor {
+    type Output;
+    fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Self::Output;
+}
+
+/// Composes the contact law of `c` and hands it to `v`. Without friction the law has no
+/// tangential history, torque or spin (model only what the case needs).
+pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> V::Output {
+    let normal = LinearSpringDashpot {
+        kn: c.kn,
+        gamman: c.gamman,
+    };
+    if c.clip_normal {
+        with_tangential(c, Clipped(normal), v)
+    } else {
+        with_tangential(c, normal, v)
+    }
+}
+
+fn with_tangential<N, V>(c: &case::Contact, normal: N, v: V) -> V::Output
+where
+    N: NormalModel + Clone + 'static,
+    V: LawVisitor,
+{
+    fn compose<N, T, V>(normal: N, tangential: T, v: V) -> V::Output
+    where
+        N: NormalModel + Clone + 'static,
+        T: TangentialModel + Clone + 'static,
+        V: LawVisitor,
+    {
+        v.visit(Composed { normal, tangential })
+    }
+    if c.mu <= 0.0 {
+        return compose(normal, Frictionless, v);
+    }
+    let (kt, gammat, mu) = (c.kt, c.gammat, c.mu);
+    match c.tangential {
+        Tangential::Mercury => compose(normal, MercurySlidingFriction { kt, gammat, mu }, v),
+        Tangential::LammpsHookeHistory => {
+            compose(normal, LammpsHookeHistory::new(kt, gammat, mu), v)
+        }
+        Tangential::LammpsGranular => compose(normal, LammpsGranular::new(kt, gammat, mu), v),
+        Tangential::Liggghts => compose(normal, Liggghts::new(kt, gammat, mu), v),
+        Tangential::Yade => compose(normal, YadeApprox::new(kt, gammat, mu), v),
+        Tangential::Cundall => compose(normal, Cundall1979::new(kt, gammat, mu), v),
+        Tangential::Objective => compose(normal, Objective::new(kt, gammat, mu), v),
+    }
+}
+
+struct BuildSimulation(Core);
+
+impl LawVisitor for BuildSimulation {
+    type Output = Box<dyn Engine>;
+    fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Box<dyn Engine> {
+        Box::new(Simulation::new(law, self.0))
+    }
 }
 
 /// A ready-to-run simulation of `scene` under the case's contact law.
@@ -35,47 +98,5 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         o.threads.unwrap_or(case.run.threads),
     );
     core.time = scene.time;
-    let c = &case.contact;
-    let normal = LinearSpringDashpot {
-        kn: c.kn,
-        gamman: c.gamman,
-    };
-    let friction = match c.tangential {
-        Tangential::Mercury => MercurySlidingFriction {
-            kt: c.kt,
-            gammat: c.gammat,
-            mu: c.mu,
-        },
-    };
-    // Model only what the case needs: without friction no tangential history, torque or spin.
-    match (c.mu > 0.0, c.clip_normal) {
-        (true, false) => Box::new(Simulation::new(
-            Composed {
-                normal,
-                tangential: friction,
-            },
-            core,
-        )),
-        (true, true) => Box::new(Simulation::new(
-            Composed {
-                normal: Clipped(normal),
-                tangential: friction,
-            },
-            core,
-        )),
-        (false, false) => Box::new(Simulation::new(
-            Composed {
-                normal,
-                tangential: Frictionless,
-            },
-            core,
-        )),
-        (false, true) => Box::new(Simulation::new(
-            Composed {
-                normal: Clipped(normal),
-                tangential: Frictionless,
-            },
-            core,
-        )),
-    }
+    with_law(&case.contact, BuildSimulation(core))
 }

@@ -15,6 +15,7 @@ pub mod domain;
 pub mod engine;
 pub mod hash;
 pub mod io;
+pub mod kinematics;
 pub mod neighbor;
 pub mod peers;
 pub mod run;

@@ -137,7 +137,7 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                     Vec3::from(s.x),
                     Vec3::from(s.v),
                     Vec3::from(s.w),
-                    0.5 * d,
+                    s.radius.unwrap_or(0.5 * d),
                     rho,
                     motion,
                 );

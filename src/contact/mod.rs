@@ -8,10 +8,14 @@
 //! positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on P
 //! (I receives the opposite).
 
+pub mod conventions;
 pub mod normal;
 pub mod tangential;
 
 use crate::Vec3;
+pub use conventions::{
+    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, Objective, YadeApprox,
+};
 pub use normal::{LinearSpringDashpot, NormalModel};
 pub use tangential::{Frictionless, MercurySlidingFriction, TangentialModel};
 
@@ -36,6 +40,14 @@ pub struct PairKinematics {
     pub vt: Vec3,
     /// Relative velocity of the centres v_P − v_I.
     pub v_centres: Vec3,
+    /// Separation x_P − x_I (minimum image; length).
+    pub r: Vec3,
+    /// Radii of P and I (length).
+    pub rad_p: f64,
+    pub rad_i: f64,
+    /// Angular velocities of P and I (1/time).
+    pub w_p: Vec3,
+    pub w_i: Vec3,
 }
 
 /// Force and torques produced by one contact.
@@ -97,6 +109,11 @@ impl PairInput {
             vn,
             vt,
             v_centres: self.v_p - self.v_i,
+            r: self.r,
+            rad_p: self.rad_p,
+            rad_i: self.rad_i,
+            w_p: self.w_p,
+            w_i: self.w_i,
         })
     }
 }
@@ -128,12 +145,19 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
         if T::ACTIVE {
             let ft = self.tangential.force(k, fn_signed, xi, dt);
             let f = fn_signed * k.n + ft;
+            // Lever arms of the torques: to the contact point in the middle of the overlap
+            // (MercuryDPM), or full radii along n where the convention's source does so.
+            let (arm_p, arm_i) = if T::FULL_RADIUS_LEVER {
+                (-k.rad_p * k.n, k.rad_i * k.n)
+            } else {
+                (k.arm_p, k.arm_i)
+            };
             PairForce {
                 f,
                 fn_signed,
                 // Torque about each centre: (c − x) × F (MercuryDPM BaseInteraction).
-                torque_p: k.arm_p.cross(&f),
-                torque_i: k.arm_i.cross(&(-f)),
+                torque_p: arm_p.cross(&f),
+                torque_i: arm_i.cross(&(-f)),
             }
         } else {
             PairForce {

@@ -9,6 +9,9 @@ use crate::Vec3;
 pub trait TangentialModel: Send + Sync {
     /// False for models that never produce a tangential force.
     const ACTIVE: bool;
+    /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
+    /// arms to the contact point in the middle of the overlap.
+    const FULL_RADIUS_LEVER: bool = false;
     fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3;
 }
 

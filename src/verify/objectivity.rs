@@ -1,0 +1,166 @@
+//! Objectivity of the tangential force under a rigid rotation of a loaded contact, per
+//! tangential convention, through the kinematics driver.
+//!
+//! Sphere 2 is spun about an axis of the tangent plane until the tangential spring carries
+//! about a fifth of mu·fn, held still, then the pair is rotated rigidly by 1 rad (positions,
+//! orientations and spins consistent with the rigid motion) about an axis in the tangent plane
+//! about the contact normal, or about an axis mixing both, in 10⁵ steps. An objective law keeps Fn and |Ft| constant and
+//! turns Ft with the pair: every drift below is expected to vanish (per radian). Only the
+//! objective reference law is held to it; the peers' rows document their conventions (a
+//! first-order frame update drifts by about half the step's turn per radian, 5e-6 here).
+
+use nalgebra::{Rotation3, Unit, UnitQuaternion};
+
+use super::{row_abs, Row};
+use crate::case::{Case, Scene, Tangential};
+use crate::kinematics::{drive, law_of, ForceRow, Increment, MotionRow};
+use crate::Vec3;
+
+/// Steps of the rigid rotation per radian.
+const STEPS_PER_RADIAN: usize = 100_000;
+
+/// The two spheres' starting positions and radii, from the case's `spheres` scene (an error
+/// naming the file for any other scene).
+pub fn pair_of(case: &Case) -> anyhow::Result<([Vec3; 2], [f64; 2])> {
+    let sphere = match &case.scene {
+        Scene::Spheres { sphere } if sphere.len() == 2 => sphere,
+        _ => anyhow::bail!(
+            "{}: scene: a contact of two spheres needs `kind = \"spheres\"` with exactly two \
+             [[scene.sphere]]",
+            case.path.display()
+        ),
+    };
+    let r = |k: usize| sphere[k].radius.unwrap_or(0.5 * case.material.diameter);
+    Ok((
+        [Vec3::from(sphere[0].x), Vec3::from(sphere[1].x)],
+        [r(0), r(1)],
+    ))
+}
+
+/// Appends `steps` rows rotating the whole pair rigidly about `axis` through the origin by
+/// `angle`, starting from the last row.
+pub fn rigid_rotation(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f64) {
+    let from = *rows.last().expect("a starting row");
+    let axis = Unit::new_normalize(axis);
+    let omega = axis.into_inner() * (angle / (steps as f64 * dt));
+    for k in 1..=steps {
+        let q = UnitQuaternion::from_axis_angle(&axis, angle * k as f64 / steps as f64);
+        let x = [q * from.x[0], q * from.x[1]];
+        rows.push(MotionRow {
+            t: from.t + k as f64 * dt,
+            x,
+            q: [q * from.q[0], q * from.q[1]],
+            v: [omega.cross(&x[0]), omega.cross(&x[1])],
+            w: [omega, omega],
+        });
+    }
+}
+
+/// Appends `steps` rows spinning sphere 2 about `axis` by `angle` in place, then `hold` still
+/// rows, starting from the last row.
+pub fn spin_sphere_2(
+    rows: &mut Vec<MotionRow>,
+    axis: Vec3,
+    angle: f64,
+    steps: usize,
+    hold: usize,
+    dt: f64,
+) {
+    let from = *rows.last().expect("a starting row");
+    let axis = Unit::new_normalize(axis);
+    let omega = axis.into_inner() * (angle / (steps as f64 * dt));
+    for k in 1..=steps + hold {
+        let turned = angle * k.min(steps) as f64 / steps as f64;
+        let mut row = from;
+        row.t = from.t + k as f64 * dt;
+        row.q[1] = UnitQuaternion::from_axis_angle(&axis, turned) * from.q[1];
+        row.w[1] = if k <= steps { omega } else { Vec3::zeros() };
+        rows.push(row);
+    }
+}
+
+/// Tangential part of the force on sphere 2.
+pub fn tangential_force(f: &ForceRow, n: Vec3) -> Vec3 {
+    f.f[1] - f.f[1].dot(&n) * n
+}
+
+/// Drifts per radian (Fn, |Ft|, direction of Ft) of `case`'s law rotated about `axis`.
+pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
+    let (x, radius) = pair_of(case)?;
+    let dt = case.dt();
+    let start = MotionRow {
+        t: 0.0,
+        x,
+        q: [UnitQuaternion::identity(); 2],
+        v: [Vec3::zeros(); 2],
+        w: [Vec3::zeros(); 2],
+    };
+    let n0 = (x[1] - x[0]).normalize();
+    let fn0 = case.contact.kn * (radius[0] + radius[1] - (x[1] - x[0]).norm());
+    // spin about a tangent axis until the spring carries ~ mu fn / 5
+    let tangent = n0
+        .cross(&Vec3::x())
+        .try_normalize(1e-9)
+        .unwrap_or(Vec3::y());
+    let load = 0.2 * case.contact.mu * fn0 / case.contact.kt / radius[1];
+    let mut rows = vec![start];
+    spin_sphere_2(&mut rows, tangent, load, 100, 10, dt);
+    let loaded = rows.len() - 1;
+    rigid_rotation(&mut rows, axis, 1.0, STEPS_PER_RADIAN, dt);
+    let law = law_of(case);
+    let f = drive(law.as_ref(), radius, &rows, Increment::Positions);
+    let end = rows.len() - 1;
+    let rot = Rotation3::from_axis_angle(&Unit::new_normalize(axis), 1.0);
+    let n1 = rot * n0;
+    let (ft0, ft1) = (
+        tangential_force(&f[loaded], n0),
+        tangential_force(&f[end], n1),
+    );
+    let turned = rot * ft0;
+    Ok([
+        (f[end].fn_signed - f[loaded].fn_signed) / f[loaded].fn_signed,
+        (ft1.norm() - ft0.norm()) / ft0.norm(),
+        ft1.angle(&turned),
+    ])
+}
+
+/// The objectivity rows of every tangential convention.
+pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+    let (x, _) = pair_of(base)?;
+    let n0 = (x[1] - x[0]).normalize();
+    let in_plane = n0
+        .cross(&Vec3::x())
+        .try_normalize(1e-9)
+        .unwrap_or(Vec3::y());
+    let mut rows = Vec::new();
+    for conv in Tangential::ALL {
+        let mut case = base.clone();
+        case.contact.tangential = conv;
+        let oblique = (in_plane + n0 + in_plane.cross(&n0)).normalize();
+        for (label, axis) in [
+            ("tangent axis", in_plane),
+            ("normal axis", n0),
+            ("oblique axis", oblique),
+        ] {
+            let [dfn, dft, dir] = drifts(&case, axis)?;
+            let name = format!("objectivity {} {label}", conv.name());
+            let gate = |r: Row| {
+                if conv == Tangential::Objective {
+                    r
+                } else {
+                    r.documenting()
+                }
+            };
+            rows.push(gate(row_abs(&name, "Fn drift per rad", 0.0, dfn, 1e-6)));
+            rows.push(gate(row_abs(&name, "|Ft| drift per rad", 0.0, dft, 1e-6)));
+            rows.push(gate(row_abs(
+                &name,
+                "Ft direction error per rad",
+                0.0,
+                dir,
+                1e-6,
+            )));
+        }
+    }
+    Ok(rows)
+}

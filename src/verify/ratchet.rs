@@ -1,0 +1,161 @@
+//! Ratcheting: closed cycles of relative motion below the sliding limit (McNamara, García-Rojo &
+//! Herrmann, PRE 77, 031304, 2008), per tangential convention, through the kinematics driver.
+//!
+//! At constant overlap (constant normal load), with the dashpots switched off: (A) sphere 2
+//! translates around sphere 1 by an arc dx (an orbit at constant distance, loading the spring
+//! to about half of mu·fn), (B) the pair rotates rigidly by a, (C) sphere 2 translates back by
+//! −dx, (D) the pair rotates back by −a. The spheres end exactly where they started, so an
+//! elastic contact must return to its initial (zero) force with zero net work. A slip that is
+//! not objective deposits a spurious displacement −δ·Ω×n·dt during the rigid rotations (δ the
+//! overlap, i.e. fn/kn), which the two rotations cancel only to O(δ·a·dx). A spring that does
+//! not twist with the contact (every convention but Yade's and the objective law) is left
+//! turned by the rotation's twist: a residual ≈ kt·dx·a whatever the load, which dominates the
+//! δ-part here. The rotation is a = 0.1 rad, so that no convention reaches the sliding limit
+//! (a full-radius slip adds −δ·a to the spring while the pair turns).
+
+use nalgebra::{Unit, UnitQuaternion};
+
+use super::objectivity::{pair_of, rigid_rotation};
+use super::{row_abs, Row};
+use crate::case::{Case, Tangential};
+use crate::kinematics::{drive, law_of, ForceRow, Increment, MotionRow};
+use crate::Vec3;
+
+/// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`,
+/// starting from the last row.
+fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f64) {
+    let from = *rows.last().expect("a starting row");
+    let axis = Unit::new_normalize(axis);
+    let omega = axis.into_inner() * (angle / (steps as f64 * dt));
+    for k in 1..=steps {
+        let q = UnitQuaternion::from_axis_angle(&axis, angle * k as f64 / steps as f64);
+        let mut row = from;
+        row.t = from.t + k as f64 * dt;
+        row.x[1] = from.x[0] + q * (from.x[1] - from.x[0]);
+        row.v[1] = omega.cross(&(row.x[1] - from.x[0]));
+        rows.push(row);
+    }
+}
+
+/// Net work done on the contact over the rows (trapezoidal in the forces, exact displacements
+/// and rotation vectors), in units of force·length.
+fn net_work(rows: &[MotionRow], f: &[ForceRow]) -> f64 {
+    let mut w = 0.0;
+    for k in 1..rows.len() {
+        for s in 0..2 {
+            let dx = rows[k].x[s] - rows[k - 1].x[s];
+            let dphi = (rows[k].q[s] * rows[k - 1].q[s].inverse()).scaled_axis();
+            w += 0.5 * (f[k].f[s] + f[k - 1].f[s]).dot(&dx);
+            w += 0.5 * (f[k].torque[s] + f[k - 1].torque[s]).dot(&dphi);
+        }
+    }
+    w
+}
+
+/// What one cycle left behind.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cycle {
+    /// Tangential force at the end (force units).
+    pub residual: f64,
+    /// Largest tangential force during the cycle.
+    pub peak: f64,
+    /// Net work done on the contact (force·length).
+    pub work: f64,
+}
+
+/// One cycle with the pair rotated about `axis` by 1 rad, at the case's positions scaled to
+/// the overlap `overlap`, translating by the arc `dx`.
+pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<Cycle> {
+    let (mut x, radius) = pair_of(case)?;
+    let dt = case.dt();
+    let n0 = (x[1] - x[0]).normalize();
+    x[1] = x[0] + n0 * (radius[0] + radius[1] - overlap);
+    let orbit_axis = n0
+        .cross(&Vec3::x())
+        .try_normalize(1e-9)
+        .unwrap_or(Vec3::y());
+    let theta = dx / (radius[0] + radius[1]);
+    let a = 0.1;
+    let mut rows = vec![MotionRow {
+        t: 0.0,
+        x,
+        q: [UnitQuaternion::identity(); 2],
+        v: [Vec3::zeros(); 2],
+        w: [Vec3::zeros(); 2],
+    }];
+    orbit(&mut rows, orbit_axis, theta, 2000, dt);
+    rigid_rotation(&mut rows, axis, a, 10_000, dt);
+    let turned = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), a) * orbit_axis;
+    orbit(&mut rows, turned, -theta, 2000, dt);
+    rigid_rotation(&mut rows, axis, -a, 10_000, dt);
+    let law = law_of(case);
+    let f = drive(law.as_ref(), radius, &rows, Increment::Positions);
+    Ok(Cycle {
+        residual: f.last().map_or(0.0, |r| r.ft),
+        peak: f.iter().map(|r| r.ft).fold(0.0, f64::max),
+        work: net_work(&rows, &f),
+    })
+}
+
+/// The ratcheting rows of every tangential convention: at the case's overlap and at twice it.
+pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+    let (x, radius) = pair_of(base)?;
+    let n0 = (x[1] - x[0]).normalize();
+    let tangent = n0
+        .cross(&Vec3::x())
+        .try_normalize(1e-9)
+        .unwrap_or(Vec3::y());
+    let along = tangent.cross(&n0);
+    let overlap = radius[0] + radius[1] - (x[1] - x[0]).norm();
+    // loads the spring to half the sliding limit at the case's overlap
+    let dx = 0.5 * base.contact.mu * base.contact.kn * overlap / base.contact.kt;
+    let mut rows = Vec::new();
+    for conv in Tangential::ALL {
+        let mut case = base.clone();
+        case.contact.tangential = conv;
+        case.contact.gamman = 0.0;
+        case.contact.gammat = 0.0;
+        for (label, axis) in [("rotation about n", n0), ("rotation about t", along)] {
+            let c = cycle(&case, axis, overlap, dx)?;
+            let twice = cycle(&case, axis, 2.0 * overlap, dx)?;
+            let energy = c.peak * c.peak / (2.0 * case.contact.kt);
+            let name = format!("ratchet {} {label}", conv.name());
+            let gate = |r: Row| {
+                if conv == Tangential::Objective {
+                    r
+                } else {
+                    r.documenting()
+                }
+            };
+            let (res, work) = (c.residual / c.peak, c.work / energy);
+            rows.push(gate(row_abs(
+                &name,
+                "residual |Ft| / peak |Ft|",
+                0.0,
+                res,
+                1e-6,
+            )));
+            rows.push(gate(row_abs(
+                &name,
+                "net work / peak elastic energy",
+                0.0,
+                work,
+                1e-6,
+            )));
+            // A spring that does not twist with the pair is left turned by the rotation's
+            // twist, ≈ a·cos θ, wherever the translations put it: a residual ≈ kt·dx·a,
+            // independent of the load.
+            let twists = matches!(conv, Tangential::Yade | Tangential::Objective);
+            if !twists && label == "rotation about n" {
+                rows.push(row_abs(
+                    &name,
+                    "load exponent of the residual (fn x2)",
+                    0.0,
+                    (twice.residual / c.residual).log2(),
+                    0.05,
+                ));
+            }
+        }
+    }
+    Ok(rows)
+}
