@@ -216,6 +216,10 @@ pub enum Scene {
     },
     /// An explicit list of spheres (verification cases).
     Spheres { sphere: Vec<SphereSpec> },
+    /// A gas filling the whole box: `count` spheres placed without overlap (lattice and
+    /// hard-sphere Monte Carlo, seeded by `run.seed`), velocities uniform random with the rms
+    /// speed `speed` and zero total momentum, no spin.
+    Gas { count: usize, speed: f64 },
 }
 
 /// One sphere of a `spheres` scene.
@@ -383,6 +387,12 @@ impl Case {
                         format!("must exceed bottom_z, got {top_z} <= {bottom_z}"),
                     ));
                 }
+            }
+            Scene::Gas { count, speed } => {
+                if *count == 0 {
+                    return Err(err("scene", "count", "must be > 0, got 0".into()));
+                }
+                non_negative("scene", "speed", *speed)?;
             }
             Scene::Spheres { sphere } => {
                 if sphere.is_empty() {

@@ -189,6 +189,7 @@ fn cg_options_for(case: &Case) -> CgOptions {
             ..
         } => 2 * wall_rows * wall_per_row,
         verdem::case::Scene::Spheres { sphere } => sphere.iter().take_while(|s| s.fixed).count(),
+        verdem::case::Scene::Gas { .. } => 0,
     };
     CgOptions {
         from: None,

@@ -126,6 +126,16 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                 }
             }
         }
+        SceneSpec::Gas { count, speed } => {
+            let z = (domain.lo.z + 0.5 * d, domain.hi.z - 0.5 * d);
+            let x = random_fill(&domain, &[], *count, d, z, case.run.seed)?;
+            for (x, v) in x
+                .into_iter()
+                .zip(random_velocities(*count, *speed, case.run.seed))
+            {
+                particles.push(x, v, Vec3::zeros(), 0.5 * d, rho, Motion::Free);
+            }
+        }
         SceneSpec::Spheres { sphere } => {
             for (k, s) in sphere.iter().enumerate() {
                 let motion = if s.fixed {
@@ -204,6 +214,27 @@ pub fn bumpy_wall(rows: usize, per_row: usize, d: f64, z: f64) -> Vec<Vec3> {
         }
     }
     out
+}
+
+/// `n` velocities uniform in a cube, shifted to zero mean and scaled to the rms speed `speed`
+/// (seeded; a different stream from the positions').
+pub fn random_velocities(n: usize, speed: f64, seed: u64) -> Vec<Vec3> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed ^ 0x05ee_d0f7_e10c_17e5);
+    let mut v: Vec<Vec3> = (0..n)
+        .map(|_| {
+            Vec3::new(
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+            )
+        })
+        .collect();
+    let mean = v.iter().sum::<Vec3>() / n as f64;
+    let rms = (v.iter().map(|u| (u - mean).norm_squared()).sum::<f64>() / n as f64).sqrt();
+    for u in v.iter_mut() {
+        *u = (*u - mean) * (speed / rms);
+    }
+    v
 }
 
 /// `n` non-overlapping spheres of diameter `d`, placed randomly and homogeneously with centres

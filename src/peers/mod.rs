@@ -91,7 +91,9 @@ fn wall_speeds(case: &Case) -> anyhow::Result<(f64, f64)> {
         Scene::BumpyShear {
             bottom_vx, top_vx, ..
         } => Ok((bottom_vx, top_vx)),
-        Scene::Spheres { .. } => bail!("peer inputs are generated for bumpy-shear cases"),
+        Scene::Spheres { .. } | Scene::Gas { .. } => {
+            bail!("peer inputs are generated for bumpy-shear cases")
+        }
     }
 }
 

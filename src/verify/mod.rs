@@ -6,9 +6,11 @@
 //!   Coulomb slider (Walton; Chung & Ooi 2011), per tangential convention;
 //! - [`objectivity`]: a loaded contact rotated rigidly, per convention (kinematics driver);
 //! - [`ratchet`]: closed cycles of relative motion below the sliding limit (McNamara et al.
-//!   2008), per convention (kinematics driver).
+//!   2008), per convention (kinematics driver);
+//! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster.
 
 pub mod collision;
+pub mod conservation;
 pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
@@ -79,6 +81,7 @@ pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
     rows.extend(oblique::rows(&load("oblique_impact.toml")?)?);
     rows.extend(objectivity::rows(&load("objectivity.toml")?)?);
     rows.extend(ratchet::rows(&load("objectivity.toml")?)?);
+    rows.extend(conservation::rows(&load("conservation.toml")?, 1_000_000)?);
     Ok(rows)
 }
 
