@@ -114,6 +114,7 @@ pub fn run(
                         case,
                         &data_path.canonicalize()?.display().to_string(),
                         steps,
+                        None,
                     )?;
                     let seconds = peers::run(*peer, *np, &dir, &script)?;
                     m.rates.push(steps as f64 / seconds);

@@ -120,7 +120,7 @@ pub struct Material {
 }
 
 /// Tangential contact conventions.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tangential {
     /// MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring +

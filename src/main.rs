@@ -123,6 +123,41 @@ enum Command {
         /// Only the rows whose case name contains this text.
         #[arg(long)]
         only: Option<String>,
+        /// Also run the binary collisions in these installed peers (lammps, liggghts), against
+        /// the same closed forms.
+        #[arg(long, value_enum, value_delimiter = ',')]
+        peers: Vec<verdem::peers::Peer>,
+        /// Where the peers' collision runs go.
+        #[arg(long, default_value = "out/verify")]
+        out: PathBuf,
+    },
+    /// Run LAMMPS or LIGGGHTS and verdem (with the peer's tangential convention) on the same
+    /// case and state; compare positions, velocities and spins at every save; write both
+    /// series as MercuryCG saves and the table as OUT/cross.md.
+    Cross {
+        /// The peer: lammps (`lmp`) or liggghts (`liggghts`), run with mpirun.
+        #[arg(value_enum)]
+        peer: verdem::peers::Peer,
+        /// Case file (default: cases/shear_flow_quick.toml).
+        #[arg(default_value = "cases/shear_flow_quick.toml")]
+        case: PathBuf,
+        /// State to start from.
+        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        from: PathBuf,
+        #[arg(long, default_value_t = 20000)]
+        steps: u64,
+        /// A save every N steps.
+        #[arg(long, default_value_t = 2000)]
+        every: u64,
+        /// MPI ranks of the peer (and verdem's threads).
+        #[arg(long, default_value_t = 2)]
+        np: usize,
+        #[arg(long, default_value = "out/cross")]
+        out: PathBuf,
+        /// Run verdem with this tangential convention instead of the peer's (to see what a
+        /// convention changes).
+        #[arg(long, value_enum)]
+        convention: Option<verdem::case::Tangential>,
     },
     /// Drive one contact of the case's law through a prescribed motion (MOTION.csv: t, then
     /// x,y,z, qw,qx,qy,qz, vx,vy,vz, wx,wy,wz of sphere 1 and of sphere 2) and write the forces
@@ -371,8 +406,18 @@ fn real_main() -> anyhow::Result<()> {
                 bench::csv(&measured, particles).as_bytes(),
             )?;
         }
-        Command::Verify { cases, only } => {
+        Command::Verify {
+            cases,
+            only,
+            peers,
+            out,
+        } => {
             let mut rows = verdem::verify::all(&cases)?;
+            let collision = Case::load(&cases.join("binary_collision.toml"))?;
+            for peer in peers {
+                let dir = out.join(peer.binary());
+                rows.extend(verdem::peers::collision::rows(peer, &collision, &dir)?);
+            }
             if let Some(only) = only {
                 rows.retain(|r| r.case.contains(&only));
             }
@@ -386,6 +431,25 @@ fn real_main() -> anyhow::Result<()> {
             if failed > 0 {
                 std::process::exit(1);
             }
+        }
+        Command::Cross {
+            peer,
+            case,
+            from,
+            steps,
+            every,
+            np,
+            out,
+            convention,
+        } => {
+            let case = Case::load(&case)?;
+            let out = out.join(peer.binary());
+            let convention = convention.unwrap_or(verdem::peers::cross::convention_of(peer));
+            let report = verdem::peers::cross::cross(
+                peer, &case, convention, &from, steps, every, np, &out,
+            )?;
+            print!("{}", report.markdown());
+            println!("(saves and tables in {})", out.display());
         }
         Command::Kinematics {
             case,

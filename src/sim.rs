@@ -91,6 +91,10 @@ pub struct Core {
     pub moved_bound: f64,
     /// Worker threads of the step.
     pub threads: usize,
+    /// Whether the force evaluation before the first step advances the tangential springs by
+    /// one step, as MercuryDPM's does (true, the default); LAMMPS and LIGGGHTS skip the
+    /// history update during their setup (`update->setupflag`), which cross-runs mirror.
+    pub setup_advances_history: bool,
     pub times: StageTimes,
     /// Set by the pair pass for both particles of every contact, read and cleared by the next
     /// particle pass: a particle without contacts skips the gather (its sum is exactly zero).
@@ -158,6 +162,7 @@ impl Core {
             forces_ready: false,
             moved_bound: 0.0,
             threads,
+            setup_advances_history: true,
             times: StageTimes::default(),
             touched: Vec::new(),
             near_face: Vec::new(),
@@ -333,12 +338,13 @@ impl<L: ContactLaw> Simulation<L> {
         self.core.rebuild();
         let c = &mut self.core;
         let parts = ParticleSlices::of(&c.particles);
+        let dt = if c.setup_advances_history { c.dt } else { 0.0 };
         for k in 0..c.pairs.p.len() {
             let (p, i) = (c.pairs.p[k] as usize, c.pairs.i[k] as usize);
             pair_force::<L, true>(
                 &self.law,
                 &c.domain,
-                c.dt,
+                dt,
                 p,
                 i,
                 &parts,

@@ -67,28 +67,9 @@ pub struct Outcome {
 /// Simulates two spheres of `base`'s material and contact law, with dt = tc_ff/`per_tc`, until
 /// their contact ends.
 pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Outcome> {
-    let mut case = base.clone();
-    case.run.dt = None;
-    case.run.steps_per_collision = Some(per_tc);
+    let (case, mut e) = impact_setup(base, bodies, per_tc)?;
     let dt = case.dt();
-    let Scene::Spheres { sphere } = &mut case.scene else {
-        anyhow::bail!("{}: an impact needs a spheres scene", base.path.display());
-    };
-    anyhow::ensure!(
-        sphere.len() == 2,
-        "{}: needs exactly two spheres",
-        base.path.display()
-    );
-    for (s, b) in sphere.iter_mut().zip(bodies) {
-        s.x = b.x.into();
-        s.v = b.v.into();
-        s.w = b.w.into();
-        s.radius = b.radius;
-        s.fixed = b.fixed;
-    }
-    let scene = crate::scene::build(&case, None)?;
-    let reach = scene.particles.radius[0] + scene.particles.radius[1];
-    let mut e = engine::build(&case, scene, &Overrides::default());
+    let reach = e.core().particles.radius[0] + e.core().particles.radius[1];
     let (mut started, mut steps_in_contact, mut delta_max) = (false, 0u64, 0.0f64);
     for _ in 0..100_000 {
         e.advance(1);
@@ -110,6 +91,53 @@ pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Out
         }
     }
     anyhow::bail!("{}: no complete collision", base.path.display())
+}
+
+/// The case (dt = tc_ff/`per_tc`) and a simulation of the two spheres `bodies` of `base`'s
+/// material and law, at step 0.
+pub fn impact_setup(
+    base: &Case,
+    bodies: [Body; 2],
+    per_tc: f64,
+) -> anyhow::Result<(Case, Box<dyn crate::sim::Engine>)> {
+    let mut case = base.clone();
+    case.run.dt = None;
+    case.run.steps_per_collision = Some(per_tc);
+    let Scene::Spheres { sphere } = &mut case.scene else {
+        anyhow::bail!("{}: an impact needs a spheres scene", base.path.display());
+    };
+    anyhow::ensure!(
+        sphere.len() == 2,
+        "{}: needs exactly two spheres",
+        base.path.display()
+    );
+    for (s, b) in sphere.iter_mut().zip(bodies) {
+        s.x = b.x.into();
+        s.v = b.v.into();
+        s.w = b.w.into();
+        s.radius = b.radius;
+        s.fixed = b.fixed;
+    }
+    let scene = crate::scene::build(&case, None)?;
+    let e = engine::build(&case, scene, &Overrides::default());
+    Ok((case, e))
+}
+
+/// Two spheres on the x axis, sphere 1 moving at `v0` towards sphere 2 (fixed when `wall`),
+/// a gap of (2 + `phase`)·v0·dt apart, so that the contact begins within a few steps.
+pub fn head_on(v0: f64, wall: bool, dt: f64, phase: f64) -> [Body; 2] {
+    let gap = (2.0 + phase) * v0 * dt;
+    let body = |x: f64, v: f64, fixed: bool| Body {
+        x: Vec3::new(x, 0.0, 0.0),
+        v: Vec3::new(v, 0.0, 0.0),
+        w: Vec3::zeros(),
+        radius: None,
+        fixed,
+    };
+    [
+        body(-0.5 - 0.5 * gap, v0, false),
+        body(0.5 + 0.5 * gap, 0.0, wall),
+    ]
 }
 
 /// What one simulated head-on collision gave.
@@ -136,23 +164,7 @@ pub fn collide_with_phase(
     let mut case = base.clone();
     case.run.dt = None;
     case.run.steps_per_collision = Some(per_tc);
-    // start a little apart, so the contact begins within a few steps at any speed
-    let gap = (2.0 + phase) * v0 * case.dt();
-    let body = |x: f64, v: f64, fixed: bool| Body {
-        x: Vec3::new(x, 0.0, 0.0),
-        v: Vec3::new(v, 0.0, 0.0),
-        w: Vec3::zeros(),
-        radius: None,
-        fixed,
-    };
-    let out = impact(
-        base,
-        [
-            body(-0.5 - 0.5 * gap, v0, false),
-            body(0.5 + 0.5 * gap, 0.0, wall),
-        ],
-        per_tc,
-    )?;
+    let out = impact(base, head_on(v0, wall, case.dt(), phase), per_tc)?;
     Ok(Measured {
         e: (out.v[1] - out.v[0]).x / v0,
         duration: out.steps_in_contact as f64 * out.dt,

@@ -1,0 +1,187 @@
+//! Cross-runs: a peer (LAMMPS or LIGGGHTS) and verdem on the same case, from the same state, for
+//! the same steps, compared particle by particle at every save.
+//!
+//! verdem runs with the peer's tangential convention (LAMMPS `granular … linear_history` →
+//! `lammps-granular`, LIGGGHTS `tangential history` → `liggghts`), so that the two codes
+//! integrate the same equations; what remains is the summation order of forces, so the
+//! trajectories agree to round-off at first and part by chaos later. The step at which the
+//! largest position difference first exceeds 1e-6 measures that onset. Both series are written
+//! as MercuryCG `.data` saves, for `verdem cg`.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use anyhow::{ensure, Context};
+
+use super::{dump, input_script, run, Peer};
+use crate::case::{Case, Tangential};
+use crate::engine::{self, Overrides};
+use crate::io::atomic;
+use crate::io::mercury::data_text;
+
+/// The verdem convention that matches `peer`'s contact law.
+pub fn convention_of(peer: Peer) -> Tangential {
+    match peer {
+        Peer::Lammps => Tangential::LammpsGranular,
+        Peer::Liggghts => Tangential::Liggghts,
+    }
+}
+
+/// Largest, median and 99th-percentile value of a sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Spread {
+    pub max: f64,
+    pub median: f64,
+    pub p99: f64,
+}
+
+impl Spread {
+    fn of(mut v: Vec<f64>) -> Spread {
+        if v.is_empty() {
+            return Spread::default();
+        }
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        Spread {
+            max: v[v.len() - 1],
+            median: at(0.5),
+            p99: at(0.99),
+        }
+    }
+}
+
+/// Differences of the peer from verdem at one save: |Δx| (minimum image), |Δv|, |Δω| over all
+/// particles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SaveDiff {
+    pub step: u64,
+    pub dx: Spread,
+    pub dv: Spread,
+    pub dw: Spread,
+}
+
+/// A cross-run's outcome.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    pub peer: Peer,
+    pub np: usize,
+    pub convention: Tangential,
+    pub saves: Vec<SaveDiff>,
+}
+
+impl Report {
+    /// The first save step whose largest position difference exceeds `threshold`.
+    pub fn diverged_at(&self, threshold: f64) -> Option<u64> {
+        self.saves
+            .iter()
+            .find(|s| s.dx.max > threshold)
+            .map(|s| s.step)
+    }
+
+    /// The comparison as a markdown table with a summary line.
+    pub fn markdown(&self) -> String {
+        let mut s = format!(
+            "{} ({} rank{}) against verdem with convention `{}`\n\n\
+             | step | max dx | median dx | p99 dx | max dv | p99 dv | max dw |\n\
+             |---|---|---|---|---|---|---|\n",
+            self.peer.binary(),
+            self.np,
+            if self.np == 1 { "" } else { "s" },
+            self.convention.name()
+        );
+        for d in &self.saves {
+            let _ = writeln!(
+                s,
+                "| {} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3e} |",
+                d.step, d.dx.max, d.dx.median, d.dx.p99, d.dv.max, d.dv.p99, d.dw.max
+            );
+        }
+        let last = self.saves.last().map_or(0, |d| d.step);
+        let _ = match self.diverged_at(1e-6) {
+            Some(step) => writeln!(s, "\nlargest |dx| first exceeds 1e-6 at step {step}"),
+            None => writeln!(s, "\nlargest |dx| stays within 1e-6 up to step {last}"),
+        };
+        s
+    }
+}
+
+/// Runs `peer` on `np` ranks and verdem (one thread per rank, tangential `convention`,
+/// normally [`convention_of`] the peer) on `case` from `state` for `steps` steps, a save every
+/// `every` steps, in `out` (`out/PEER/` holds its data file, input script, dumps and converted
+/// saves; `out/verdem/` verdem's saves).
+#[allow(clippy::too_many_arguments)]
+pub fn cross(
+    peer: Peer,
+    case: &Case,
+    convention: Tangential,
+    state: &Path,
+    steps: u64,
+    every: u64,
+    np: usize,
+    out: &Path,
+) -> anyhow::Result<Report> {
+    ensure!(
+        every > 0 && steps.is_multiple_of(every),
+        "--every must divide --steps"
+    );
+    let mut case = case.clone();
+    case.contact.tangential = convention;
+    let overrides = Overrides {
+        threads: Some(np),
+        ..Overrides::default()
+    };
+    let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
+    // both peers compute their setup forces without advancing the tangential history
+    // (`update->setupflag`)
+    e.core_mut().setup_advances_history = false;
+    e.advance(0);
+    let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
+    for d in [&peer_dir, &own_dir] {
+        std::fs::create_dir_all(d).with_context(|| d.display().to_string())?;
+    }
+    let data = super::data_file(&e.core().snapshot(), case.material.density);
+    atomic::write(&peer_dir.join("state.lmp"), data.as_bytes())?;
+    let script = input_script(peer, &case, "state.lmp", steps, Some(every))?;
+    run(peer, np, &peer_dir, &script)?;
+    let mut saves = Vec::new();
+    for k in 0..=steps / every {
+        if k > 0 {
+            e.advance(every);
+        }
+        let own = e.core().snapshot();
+        let name = format!("{}.data.{k:04}", case.name);
+        atomic::write(&own_dir.join(&name), data_text(&own).as_bytes())?;
+        let frame = dump::read(&peer_dir.join(format!("dump.{}.txt", k * every)))?;
+        ensure!(
+            frame.x.len() == own.particles.len(),
+            "{}: {} atoms, the state has {}",
+            peer.binary(),
+            frame.x.len(),
+            own.particles.len()
+        );
+        let mut theirs = own.clone();
+        theirs.contacts.clear();
+        theirs.particles.x = frame.x;
+        theirs.particles.v = frame.v;
+        theirs.particles.w = frame.w;
+        theirs.particles.radius = frame.radius;
+        atomic::write(&peer_dir.join(&name), data_text(&theirs).as_bytes())?;
+        let (a, b) = (&own.particles, &theirs.particles);
+        let n = a.len();
+        let diff = |f: &dyn Fn(usize) -> f64| Spread::of((0..n).map(f).collect());
+        saves.push(SaveDiff {
+            step: k * every,
+            dx: diff(&|i| own.domain.min_image(b.x[i] - a.x[i]).norm()),
+            dv: diff(&|i| (b.v[i] - a.v[i]).norm()),
+            dw: diff(&|i| (b.w[i] - a.w[i]).norm()),
+        });
+    }
+    let report = Report {
+        peer,
+        np,
+        convention: case.contact.tangential,
+        saves,
+    };
+    atomic::write(&out.join("cross.md"), report.markdown().as_bytes())?;
+    Ok(report)
+}
