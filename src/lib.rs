@@ -23,6 +23,7 @@ pub mod scene;
 pub mod sim;
 pub mod state;
 pub mod team;
+pub mod tradeoff;
 pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.

@@ -159,6 +159,28 @@ enum Command {
         #[arg(long, value_enum)]
         convention: Option<verdem::case::Tangential>,
     },
+    /// The speed/accuracy trade: the case under variants (dt, softer contacts, skin, threads)
+    /// from the same state for the same simulated time; cost, restitution error and the
+    /// deviation of each profile from the reference in units of its standard error.
+    Tradeoff {
+        /// Case file.
+        #[arg(default_value = "cases/shear_flow_quick.toml")]
+        case: PathBuf,
+        /// State to start from.
+        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        from: PathBuf,
+        /// Simulated time of every variant (time units).
+        #[arg(long, default_value_t = 20.0)]
+        time: f64,
+        /// Saves of every variant (all are coarse-grained).
+        #[arg(long, default_value_t = 40)]
+        saves: u64,
+        #[arg(long, default_value = "out/tradeoff")]
+        out: PathBuf,
+        /// The two-sphere case whose restitution each variant's law is measured on.
+        #[arg(long, default_value = "cases/verify/binary_collision.toml")]
+        pair: PathBuf,
+    },
     /// Drive one contact of the case's law through a prescribed motion (MOTION.csv: t, then
     /// x,y,z, qw,qx,qy,qz, vx,vy,vz, wx,wy,wz of sphere 1 and of sphere 2) and write the forces
     /// and torques on each sphere at every row (FORCES.csv).
@@ -213,30 +235,6 @@ fn print_contact_summary(case: &Case) {
         }
     }
     println!("dt = {dt:e}");
-}
-
-/// Coarse-graining defaults for a case: its wall spheres, density and periodicity.
-fn cg_options_for(case: &Case) -> CgOptions {
-    let walls = match &case.scene {
-        verdem::case::Scene::BumpyShear {
-            wall_rows,
-            wall_per_row,
-            ..
-        } => 2 * wall_rows * wall_per_row,
-        verdem::case::Scene::Spheres { sphere } => sphere.iter().take_while(|s| s.fixed).count(),
-        verdem::case::Scene::Gas { .. } => 0,
-    };
-    CgOptions {
-        from: None,
-        to: None,
-        slices: 100,
-        kernel: KernelChoice::Heaviside,
-        width: None,
-        walls,
-        density: case.material.density,
-        periodic: case.domain.periodic,
-        blocks: 10,
-    }
 }
 
 fn real_main() -> anyhow::Result<()> {
@@ -313,7 +311,7 @@ fn real_main() -> anyhow::Result<()> {
                 .with_context(|| p.display().to_string())?;
             if s.saves > 0 {
                 let (_, report) =
-                    cg::write_all(&opts.out_dir.join(&case.name), &cg_options_for(&case))?;
+                    cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
                 println!(
                     "profiles: {}",
                     opts.out_dir
@@ -334,7 +332,7 @@ fn real_main() -> anyhow::Result<()> {
             blocks,
         } => {
             let mut o = match case {
-                Some(c) => cg_options_for(&Case::load(&c)?),
+                Some(c) => CgOptions::for_case(&Case::load(&c)?),
                 None => CgOptions {
                     from: None,
                     to: None,
@@ -450,6 +448,21 @@ fn real_main() -> anyhow::Result<()> {
             )?;
             print!("{}", report.markdown());
             println!("(saves and tables in {})", out.display());
+        }
+        Command::Tradeoff {
+            case,
+            from,
+            time,
+            saves,
+            out,
+            pair,
+        } => {
+            let case = Case::load(&case)?;
+            let pair = Case::load(&pair)?;
+            let outcomes = verdem::tradeoff::run(&case, &pair, &from, time, saves, &out)?;
+            let table = verdem::tradeoff::markdown(&outcomes);
+            verdem::io::atomic::write(&out.join("tradeoff.md"), table.as_bytes())?;
+            print!("{table}");
         }
         Command::Kinematics {
             case,

@@ -39,6 +39,34 @@ pub struct CgOptions {
     pub blocks: usize,
 }
 
+impl CgOptions {
+    /// The defaults for a case's saves: its wall spheres, density and periodicity; 100 slices,
+    /// Heaviside kernel, 10 blocks, the second half of the series.
+    pub fn for_case(case: &crate::case::Case) -> CgOptions {
+        use crate::case::Scene;
+        let walls = match &case.scene {
+            Scene::BumpyShear {
+                wall_rows,
+                wall_per_row,
+                ..
+            } => 2 * wall_rows * wall_per_row,
+            Scene::Spheres { sphere } => sphere.iter().take_while(|s| s.fixed).count(),
+            Scene::Gas { .. } => 0,
+        };
+        CgOptions {
+            from: None,
+            to: None,
+            slices: 100,
+            kernel: KernelChoice::Heaviside,
+            width: None,
+            walls,
+            density: case.material.density,
+            periodic: case.domain.periodic,
+            blocks: 10,
+        }
+    }
+}
+
 /// Kernel families.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum KernelChoice {
