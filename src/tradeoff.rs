@@ -28,7 +28,7 @@ pub struct Variant {
 }
 
 /// The variants of `base` (the reference first): dt = tc/25, tc/100, tc/200; kn/10 and kn/100;
-/// skins 0.1 and 0.2 (the case files use 0.05); 1 thread.
+/// skins 0.05 and 0.2; 1 thread.
 pub fn variants(base: &Case) -> Vec<Variant> {
     let per_tc = base.tc_free_free().unwrap_or(0.0) / base.dt();
     let with = |name: &str, f: &dyn Fn(&mut Case), o: Overrides| {
@@ -68,7 +68,7 @@ pub fn variants(base: &Case) -> Vec<Variant> {
         with("dt=tc/200", &resolution(200.0), Overrides::default()),
         with("kn/10", &softer(10.0), Overrides::default()),
         with("kn/100", &softer(100.0), Overrides::default()),
-        with("skin=0.1", &|_| {}, skin(0.1)),
+        with("skin=0.05", &|_| {}, skin(0.05)),
         with("skin=0.2", &|_| {}, skin(0.2)),
         with(
             "1 thread",
