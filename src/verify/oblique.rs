@@ -25,8 +25,8 @@ use crate::Vec3;
 const WALL_RADII: f64 = 1000.0;
 
 /// Normal speed, contact-point tangential speed from translation and from spin: one impact on
-/// the wall sphere; returns (restitution of the normal velocity, β, Jt/Jn).
-fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64, f64, f64)> {
+/// the wall sphere; returns (β, Jt/Jn).
+fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64, f64)> {
     let r = 0.5 * case.material.diameter;
     let dt = case.dt();
     let gap = 2.5 * vn * dt;
@@ -50,11 +50,7 @@ fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64
     let Outcome { v, w, .. } = impact(case, [sphere, wall], per_tc)?;
     let u0 = vt + spin_slip;
     let u1 = v[0].z - r * w[0].y;
-    Ok((
-        -v[0].x / vn,
-        -u1 / u0,
-        (v[0].z - vt).abs() / (v[0].x - vn).abs(),
-    ))
+    Ok((-u1 / u0, (v[0].z - vt).abs() / (v[0].x - vn).abs()))
 }
 
 /// The oblique-impact rows of every tangential convention for the case `base` (whose law must
@@ -81,7 +77,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             let (vn, vt) = (deg.to_radians().cos(), deg.to_radians().sin());
             let psi = vt / vn;
             if psi <= 3.5 * mu {
-                let (_, beta, _) = on_wall(&unclipped, vn, vt, 0.0)?;
+                let (beta, _) = on_wall(&unclipped, vn, vt, 0.0)?;
                 let r = row_abs(
                     &format!("oblique {name} {deg}deg psi={psi:.3} stick"),
                     "tangential restitution beta = e",
@@ -98,7 +94,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
                     r
                 });
             } else if psi >= 3.5 * mu * (1.0 + cf.e_clipped) {
-                let (_, beta, ratio) = on_wall(&clipped, vn, vt, 0.0)?;
+                let (beta, ratio) = on_wall(&clipped, vn, vt, 0.0)?;
                 let case = format!("oblique {name} {deg}deg psi={psi:.3} slide clipped");
                 rows.push(row(&case, "impulse ratio Jt/Jn = mu", mu, ratio, 1e-3));
                 rows.push(row_abs(
@@ -111,7 +107,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             }
         }
         // constant normal speed, contact-point slip from an initial spin only
-        let (_, beta, _) = on_wall(&unclipped, 1.0, 0.0, 0.5)?;
+        let (beta, _) = on_wall(&unclipped, 1.0, 0.0, 0.5)?;
         rows.push(row_abs(
             &format!("oblique {name} spin only psi=0.5 stick"),
             "tangential restitution beta = e",
@@ -119,7 +115,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             beta,
             1e-2,
         ));
-        let (_, _, ratio) = on_wall(&clipped, 1.0, 0.0, 3.0)?;
+        let (_, ratio) = on_wall(&clipped, 1.0, 0.0, 3.0)?;
         rows.push(row(
             &format!("oblique {name} spin only psi=3 slide clipped"),
             "impulse ratio Jt/Jn = mu",
