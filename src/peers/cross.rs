@@ -6,7 +6,8 @@
 //! integrate the same equations; what remains is the summation order of forces, so the
 //! trajectories agree to round-off at first and part by chaos later. The step at which the
 //! largest position difference first exceeds 1e-6 measures that onset. Both series are written
-//! as MercuryCG `.data` saves, for `verdem cg`.
+//! as MercuryCG `.data` saves, verdem's also with its `.fstat` (so `verdem cg` reads it); the
+//! peers' contact forces are not converted yet.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -17,7 +18,7 @@ use super::{dump, input_script, run, Peer};
 use crate::case::{Case, Tangential};
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
-use crate::io::mercury::data_text;
+use crate::io::mercury::{data_text, fstat_text};
 
 /// The verdem convention that matches `peer`'s contact law.
 pub fn convention_of(peer: Peer) -> Tangential {
@@ -151,6 +152,8 @@ pub fn cross(
         let own = e.core().snapshot();
         let name = format!("{}.data.{k:04}", case.name);
         atomic::write(&own_dir.join(&name), data_text(&own).as_bytes())?;
+        let fstat = format!("{}.fstat.{k:04}", case.name);
+        atomic::write(&own_dir.join(&fstat), fstat_text(&own).as_bytes())?;
         let frame = dump::read(&peer_dir.join(format!("dump.{}.txt", k * every)))?;
         ensure!(
             frame.x.len() == own.particles.len(),
