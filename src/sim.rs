@@ -118,11 +118,12 @@ struct Scratch {
     fill: Vec<u32>,
     pair_keys: Vec<(bool, f64, u32)>,
     particle_ranges: Vec<(usize, usize)>,
-    /// Relative speed of each thread (work per second), learnt from the measured busy times
-    /// between builds; the shares follow it. Shares never change a bit of the results.
-    speed: Vec<f64>,
-    /// Total weight of each thread's share at the last build.
-    range_weight: Vec<u64>,
+    /// Relative speed of each thread (work per second) in the particle pass [0] and in the
+    /// pair pass [1], learnt from the busy times measured between builds: every pass ends at a
+    /// barrier, so each is balanced on its own. Shares never change a bit of the results.
+    speed: [Vec<f64>; 2],
+    /// Total weight of each thread's share of each pass at the last build.
+    range_weight: [Vec<u64>; 2],
     /// Each thread's pairs, before they are split into interior and boundary parts.
     pair_bounds: Vec<(usize, usize)>,
     /// Each thread's pairs `(a, m, b)`: interior pairs `a..m`, then pairs across a periodic
@@ -169,7 +170,7 @@ impl Core {
             builder,
             scratch: Scratch {
                 particle_ranges: vec![(0, 0); threads],
-                speed: vec![1.0; threads],
+                speed: [vec![1.0; threads], vec![1.0; threads]],
                 ..Scratch::default()
             },
         }
@@ -199,7 +200,8 @@ impl Core {
     /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
     pub fn rebuild(&mut self) {
         let domain = self.domain.clone();
-        self.list_state().rebuild(&domain, &[]);
+        self.list_state()
+            .rebuild(&domain, &[Vec::new(), Vec::new()]);
         self.moved_bound = 0.0;
     }
 
@@ -370,7 +372,8 @@ impl<L: ContactLaw> Simulation<L> {
         let threads = core.threads;
         let barrier = SpinBarrier::new(threads);
         let vmax2: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
-        let busy: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
+        let busy: [Vec<AtomicU64>; 2] =
+            [0, 1].map(|_| (0..threads).map(|_| AtomicU64::new(0)).collect());
         let skin = core.skin();
         let bound0 = core.moved_bound;
         let domain = core.domain.clone();
@@ -395,8 +398,9 @@ impl<L: ContactLaw> Simulation<L> {
                 }
             };
             let mut bound = bound0;
-            // this thread's compute time since the last build (ns), for the load balance
-            let mut busy_local = 0u64;
+            // this thread's compute time in each pass since the last build (ns), for the load
+            // balance
+            let mut busy_local = [0u64; 2];
             // Ends of the live prefixes of this thread's interior and boundary pairs.
             let mut live: Option<(usize, usize)> = None;
             for s in 0..steps {
@@ -409,7 +413,7 @@ impl<L: ContactLaw> Simulation<L> {
                     let (a, b) = l.scratch.particle_ranges[tid];
                     particle_pass::<L, ROT, GRAV>(&view, l, a, b, s > 0, true)
                 };
-                busy_local += t_start.elapsed().as_nanos() as u64;
+                busy_local[0] += t_start.elapsed().as_nanos() as u64;
                 vmax2[tid].store(v2.to_bits(), Ordering::Relaxed);
                 lap(&mut local.integrate);
                 barrier.wait();
@@ -423,8 +427,10 @@ impl<L: ContactLaw> Simulation<L> {
                 if bound > 0.5 * skin {
                     bound = 0.0;
                     live = None;
-                    busy[tid].store(busy_local, Ordering::Relaxed);
-                    busy_local = 0;
+                    for pass in 0..2 {
+                        busy[pass][tid].store(busy_local[pass], Ordering::Relaxed);
+                    }
+                    busy_local = [0; 2];
                     barrier.wait();
                     if tid == 0 {
                         unsafe { list.get().rebuild(view.domain, &busy) };
@@ -450,7 +456,7 @@ impl<L: ContactLaw> Simulation<L> {
                     let t_start = Instant::now();
                     pair_pass::<L, false>(&view, l, a, li);
                     pair_pass::<L, true>(&view, l, m, lb);
-                    busy_local += t_start.elapsed().as_nanos() as u64;
+                    busy_local[1] += t_start.elapsed().as_nanos() as u64;
                 }
                 lap(&mut local.forces);
                 barrier.wait();
@@ -511,8 +517,9 @@ fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
 impl ListState<'_> {
     /// Re-orders the particles by cell, rebuilds the pair list, carries every contact's history
     /// over (matched by original ids), and re-balances the threads' ranges; `busy` holds each
-    /// thread's compute time (ns) since the last build, when known.
-    fn rebuild(&mut self, domain: &Domain, busy: &[AtomicU64]) {
+    /// thread's compute time (ns) in the particle [0] and the pair [1] pass since the last build,
+    /// when known.
+    fn rebuild(&mut self, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
         let t0 = Instant::now();
         let s = &mut *self.scratch;
         // History of the contacts, by original ids.
@@ -551,15 +558,17 @@ impl ListState<'_> {
             .resize_with(pt.len(), || AtomicBool::new(false));
         // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
-        let ns = |t: usize| busy[t].load(Ordering::Relaxed) as f64;
-        if busy.len() == threads
-            && s.range_weight.len() == threads
-            && (0..threads).all(|t| ns(t) > 0.0)
-        {
-            let measured = |t: usize| s.range_weight[t] as f64 / ns(t);
-            let mean = (0..threads).map(measured).sum::<f64>() / threads as f64;
-            for t in 0..threads {
-                s.speed[t] = 0.5 * s.speed[t] + 0.5 * measured(t) / mean;
+        for pass in 0..2 {
+            let ns = |t: usize| busy[pass][t].load(Ordering::Relaxed) as f64;
+            if busy[pass].len() == threads
+                && s.range_weight[pass].len() == threads
+                && (0..threads).all(|t| ns(t) > 0.0)
+            {
+                let measured = |t: usize| s.range_weight[pass][t] as f64 / ns(t);
+                let mean = (0..threads).map(measured).sum::<f64>() / threads as f64;
+                for t in 0..threads {
+                    s.speed[pass][t] = 0.5 * s.speed[pass][t] + 0.5 * measured(t) / mean;
+                }
             }
         }
         let inv_mass = &pt.inv_mass;
@@ -567,14 +576,17 @@ impl ListState<'_> {
         // cost, pairs by count; the pair list is in owner (memory, so space) order, so a
         // thread's pairs lie mostly among its own particles.
         let weight = |a: usize| if inv_mass[a] > 0.0 { 8 } else { 2 };
-        balanced_ranges(pt.len(), &s.speed, weight, &mut s.particle_ranges);
-        balanced_ranges(n_pairs, &s.speed, |_| 2, &mut s.pair_bounds);
-        s.range_weight.clear();
-        s.range_weight.extend((0..threads).map(|t| {
-            let (a, b) = s.particle_ranges[t];
-            let (pa, pb) = s.pair_bounds[t];
-            (a..b).map(weight).sum::<u64>() + 2 * (pb - pa) as u64
-        }));
+        balanced_ranges(pt.len(), &s.speed[0], weight, &mut s.particle_ranges);
+        balanced_ranges(n_pairs, &s.speed[1], |_| 2, &mut s.pair_bounds);
+        let [particle_weight, pair_weight] = &mut s.range_weight;
+        particle_weight.clear();
+        particle_weight.extend(
+            s.particle_ranges
+                .iter()
+                .map(|&(a, b)| (a..b).map(weight).sum::<u64>()),
+        );
+        pair_weight.clear();
+        pair_weight.extend(s.pair_bounds.iter().map(|&(a, b)| 2 * (b - a) as u64));
         // Within a share, interior pairs (no periodic image needed until the next build) come
         // first, then the others; each part sorted by gap, so that a step visits only the
         // prefix of pairs whose gap the particles can have closed (see `live`).
