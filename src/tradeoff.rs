@@ -81,14 +81,7 @@ pub fn variants(base: &Case) -> Vec<Variant> {
     ]
 }
 
-/// The profiles compared, as (label, index in [`cg::COLUMNS`]).
-pub const FIELDS: [(&str, usize); 5] = [
-    ("vx", 2),
-    ("nu", 0),
-    ("T", 5),
-    ("pressure", 24),
-    ("shear", 25),
-];
+pub use cg::FIELDS;
 
 /// Cost and accuracy of one variant.
 #[derive(Clone, Debug)]
@@ -110,24 +103,6 @@ impl Outcome {
     /// Simulated time per wall-clock second.
     pub fn time_per_second(&self) -> f64 {
         self.steps as f64 * self.dt / self.seconds
-    }
-}
-
-/// χ²/dof of profile `col` of `a` against `b` over the core slices.
-fn chi2(a: &cg::Profiles, b: &cg::Profiles, col: usize) -> f64 {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for k in cg::core_range(&a.grid) {
-        let (ca, cb) = (cg::columns(&a.mean[k])[col], cg::columns(&b.mean[k])[col]);
-        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
-        if var > 0.0 {
-            sum += (ca - cb).powi(2) / var;
-            n += 1;
-        }
-    }
-    if n == 0 {
-        0.0
-    } else {
-        sum / n as f64
     }
 }
 
@@ -196,7 +171,7 @@ pub fn run(
         .into_iter()
         .map(|(mut o, p)| {
             for (f, (_, col)) in FIELDS.iter().enumerate() {
-                o.chi2[f] = chi2(&p, &reference, *col);
+                o.chi2[f] = cg::chi2(&p, &reference, *col);
             }
             o
         })

@@ -83,11 +83,34 @@ fn cross_runs_agree_to_round_off_with_the_peers_convention_and_not_without() {
         for s in &r.saves {
             assert!(s.dx.max < 1e-10 && s.dv.max < 1e-9, "{peer:?} {s:?}");
         }
-        // both series were written as MercuryCG saves
-        for sub in ["verdem", peer.binary()] {
+        // both series were written as MercuryCG saves; the peer's contacts are verdem's, with
+        // normal forces within the dashpot's share (the peers re-evaluate them with full-step
+        // velocities)
+        let fstat = |sub: &str| {
             let save = out.join(sub).join("shear_flow_quick.data.0004");
             verdem::io::mercury::read_data(&save).unwrap();
+            let f = out.join(sub).join("shear_flow_quick.fstat.0004");
+            let mut rows: Vec<_> = verdem::io::mercury::read_fstat(&f)
+                .unwrap()
+                .rows
+                .into_iter()
+                .filter(|r| r.i < r.j)
+                .map(|r| (r.i, r.j, r.fn_signed))
+                .collect();
+            rows.sort_by_key(|r| (r.0, r.1));
+            rows
+        };
+        let (own, theirs) = (fstat("verdem"), fstat(peer.binary()));
+        assert!(!own.is_empty());
+        assert_eq!(own.len(), theirs.len(), "{peer:?}");
+        for (a, b) in own.iter().zip(&theirs) {
+            assert_eq!((a.0, a.1), (b.0, b.1), "{peer:?}");
+            assert!(
+                (a.2 - b.2).abs() < 0.02 * a.2.abs() + 1e-6,
+                "{peer:?} {a:?} {b:?}"
+            );
         }
+        assert_eq!(r.profiles_chi2.len(), 5);
     }
     let out = dir.path().join("mismatched");
     let r = cross(

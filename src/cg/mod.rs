@@ -154,6 +154,34 @@ pub struct Profiles {
     pub tau_energy: f64,
 }
 
+/// The five profiles of the benchmark, as (label, index in [`COLUMNS`]).
+pub const FIELDS: [(&str, usize); 5] = [
+    ("vx", 2),
+    ("nu", 0),
+    ("T", 5),
+    ("pressure", 24),
+    ("shear", 25),
+];
+
+/// χ²/dof of profile `col` of `a` against `b` over the core slices: the mean of
+/// (a − b)²/(se_a² + se_b²), ≈ 1 when they differ by noise only.
+pub fn chi2(a: &Profiles, b: &Profiles, col: usize) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for k in core_range(&a.grid) {
+        let (ca, cb) = (columns(&a.mean[k])[col], columns(&b.mean[k])[col]);
+        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
+        if var > 0.0 {
+            sum += (ca - cb).powi(2) / var;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
+}
+
 /// Column names of [`columns`] (after `z`).
 pub const COLUMNS: [&str; 26] = [
     "nu", "rho", "vx", "vy", "vz", "T", "kin_xx", "kin_xy", "kin_xz", "kin_yx", "kin_yy", "kin_yz",

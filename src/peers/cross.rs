@@ -16,9 +16,13 @@ use anyhow::{ensure, Context};
 
 use super::{dump, input_script, run, Peer};
 use crate::case::{Case, Tangential};
+use crate::cg;
+use crate::contact::PairForce;
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
+use crate::sim::{Contact, Snapshot};
+use crate::Vec3;
 
 /// The verdem convention that matches `peer`'s contact law.
 pub fn convention_of(peer: Peer) -> Tangential {
@@ -68,6 +72,9 @@ pub struct Report {
     pub np: usize,
     pub convention: Tangential,
     pub saves: Vec<SaveDiff>,
+    /// χ²/dof of each profile of [`cg::FIELDS`] of the peer's series against verdem's (all
+    /// saves coarse-grained, block standard errors).
+    pub profiles_chi2: [f64; 5],
 }
 
 impl Report {
@@ -102,8 +109,63 @@ impl Report {
             Some(step) => writeln!(s, "\nlargest |dx| first exceeds 1e-6 at step {step}"),
             None => writeln!(s, "\nlargest |dx| stays within 1e-6 up to step {last}"),
         };
+        let chi2: Vec<String> = cg::FIELDS
+            .iter()
+            .zip(self.profiles_chi2)
+            .map(|((name, _), c)| format!("{name} {c:.2}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "profiles over all saves, chi2/dof against verdem (1 = noise): {}",
+            chi2.join(", ")
+        );
         s
     }
+}
+
+/// The contacts of a peer's save (its `contacts.STEP.txt`) as verdem contacts of the state `s`:
+/// P the lower index, the force on P. The peers re-evaluate these forces at the end of the step
+/// with full-step velocities in the dashpots (see [`super::input_script`]); their tangential
+/// springs are not dumped, so the `.fstat`'s spring column reads 0.
+fn peer_contacts(peer: Peer, path: &Path, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
+    let columns = match peer {
+        Peer::Lammps => 6,
+        Peer::Liggghts => 5,
+    };
+    let x = &s.particles.x;
+    let mut out = Vec::new();
+    for r in dump::read_entries(path, columns)? {
+        let (a, b) = (r[0] as usize, r[1] as usize);
+        ensure!(
+            (1..=x.len()).contains(&a) && (1..=x.len()).contains(&b),
+            "{}: atom ids {a} {b} out of range",
+            path.display()
+        );
+        let (a, b) = (a - 1, b - 1);
+        let on_a = match peer {
+            // normal force over the distance along x_a − x_b, then the tangential force on a
+            Peer::Lammps => s.domain.min_image(x[a] - x[b]) * r[2] + Vec3::new(r[3], r[4], r[5]),
+            Peer::Liggghts => Vec3::new(r[2], r[3], r[4]),
+        };
+        if on_a == Vec3::zeros() {
+            continue;
+        }
+        let (p, i, f) = if a < b { (a, b, on_a) } else { (b, a, -on_a) };
+        let n = s.domain.min_image(x[p] - x[i]).normalize();
+        out.push(Contact {
+            p: p as u32,
+            i: i as u32,
+            xi: Vec3::zeros(),
+            force: PairForce {
+                f,
+                fn_signed: f.dot(&n),
+                torque_p: Vec3::zeros(),
+                torque_i: Vec3::zeros(),
+            },
+        });
+    }
+    out.sort_unstable_by_key(|c| (c.p, c.i));
+    Ok(out)
 }
 
 /// Runs `peer` on `np` ranks and verdem (one thread per rank, tangential `convention`,
@@ -168,7 +230,13 @@ pub fn cross(
         theirs.particles.v = frame.v;
         theirs.particles.w = frame.w;
         theirs.particles.radius = frame.radius;
+        theirs.contacts = peer_contacts(
+            peer,
+            &peer_dir.join(format!("contacts.{}.txt", k * every)),
+            &theirs,
+        )?;
         atomic::write(&peer_dir.join(&name), data_text(&theirs).as_bytes())?;
+        atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
         let (a, b) = (&own.particles, &theirs.particles);
         let n = a.len();
         let diff = |f: &dyn Fn(usize) -> f64| Spread::of((0..n).map(f).collect());
@@ -179,11 +247,20 @@ pub fn cross(
             dw: diff(&|i| (b.w[i] - a.w[i]).norm()),
         });
     }
+    let mut o = cg::CgOptions::for_case(&case);
+    o.from = Some(0);
+    o.blocks = saves.len().div_ceil(4).clamp(2, 10);
+    let series = |dir: &Path| cg::Series::find(&dir.join(&case.name));
+    let (own, theirs) = (
+        cg::coarse_grain(&series(&own_dir)?, &o)?,
+        cg::coarse_grain(&series(&peer_dir)?, &o)?,
+    );
     let report = Report {
         peer,
         np,
         convention: case.contact.tangential,
         saves,
+        profiles_chi2: cg::FIELDS.map(|(_, col)| cg::chi2(&theirs, &own, col)),
     };
     atomic::write(&out.join("cross.md"), report.markdown().as_bytes())?;
     Ok(report)

@@ -89,6 +89,41 @@ pub fn read(path: &Path) -> Result<Frame, FormatError> {
     Ok(frame)
 }
 
+/// Reads a `dump local` file of `columns` numbers per entry (the contact forces of a save).
+pub fn read_entries(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> {
+    let (file, text) = read_text(path)?;
+    let lines: Vec<&str> = text.lines().collect();
+    let expect = |k: usize, name: &str| match lines.get(k) {
+        Some(l) if l.starts_with(name) => Ok(()),
+        _ => Err(err(&file, k + 1, format!("expected `{name}`"))),
+    };
+    expect(0, "ITEM: TIMESTEP")?;
+    expect(2, "ITEM: NUMBER OF ENTRIES")?;
+    let n: usize = lines
+        .get(3)
+        .and_then(|l| l.trim().parse().ok())
+        .ok_or_else(|| err(&file, 4, "expected a whole number"))?;
+    expect(8, "ITEM: ENTRIES")?;
+    let mut out = Vec::with_capacity(n);
+    let mut nums = Vec::new();
+    for e in 0..n {
+        let k = 9 + e;
+        let line = lines
+            .get(k)
+            .ok_or_else(|| err(&file, k + 1, format!("{n} entries announced, {e} found")))?;
+        parse_numbers(&file, k + 1, line, &mut nums)?;
+        if nums.len() != columns {
+            return Err(err(
+                &file,
+                k + 1,
+                format!("expected {columns} columns, got {}", nums.len()),
+            ));
+        }
+        out.push(nums.clone());
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,5 +152,21 @@ mod tests {
         std::fs::write(&p, DUMP.replace("omegaz", "fx")).unwrap();
         let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("dump.500.txt:9: columns must be"), "{e}");
+    }
+
+    #[test]
+    fn reads_local_entries_and_checks_their_columns() {
+        let text = "ITEM: TIMESTEP\n100\nITEM: NUMBER OF ENTRIES\n2\nITEM: BOX BOUNDS pp pp ff\n\
+0 20\n0 10\n0 22\nITEM: ENTRIES c_a[1] c_a[2] c_b[1]\n1 2 0.5\n3 4 -1e-3\n";
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("contacts.100.txt");
+        std::fs::write(&p, text).unwrap();
+        let rows = read_entries(&p, 3).unwrap();
+        assert_eq!(rows, vec![vec![1.0, 2.0, 0.5], vec![3.0, 4.0, -1e-3]]);
+        let e = read_entries(&p, 4).unwrap_err().to_string();
+        assert!(
+            e.ends_with("contacts.100.txt:10: expected 4 columns, got 3"),
+            "{e}"
+        );
     }
 }

@@ -114,9 +114,29 @@ fn dump_commands(peer: Peer, every: u64) -> String {
             " %.17g".repeat(DUMP_COLUMNS.len() - 2)
         ),
     };
+    // Contact forces, one line per pair in contact: `contacts.STEP.txt` with the two ids and
+    // the force on the first (LAMMPS: `pair/local` gives the normal force over the distance
+    // and the tangential force vector; LIGGGHTS: `pair/gran/local` the force vector). Both
+    // computes re-evaluate the forces at the end of the step, with full-step velocities in the
+    // dashpots, where the step itself used half-step velocities.
+    let contacts = match peer {
+        Peer::Lammps => "compute         pairs all pair/local force p1 p2 p3\n\
+compute         ids all property/local patom1 patom2\n\
+dump            contacts all local {every} contacts.*.txt c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3] c_pairs[4]\n\
+dump_modify     contacts format float %.17g\n"
+            .to_string(),
+        Peer::Liggghts => format!(
+            "compute         pairs all pair/gran/local id force\n\
+dump            contacts all local {{every}} contacts.*.txt c_pairs[1] c_pairs[2] c_pairs[4] c_pairs[5] c_pairs[6]\n\
+dump_modify     contacts format \"{}\"\n",
+            ["%.17g"; 5].join(" ")
+        ),
+    }
+    .replace("{every}", &every.to_string());
     format!(
         "dump            traj all custom {every} dump.*.txt {cols}\n\
-dump_modify     traj sort id {format}\n"
+dump_modify     traj sort id {format}\n\
+{contacts}"
     )
 }
 
