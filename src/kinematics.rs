@@ -12,7 +12,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion};
 
-use crate::case::Case;
+use crate::case::{Case, Scene};
 use crate::contact::{ContactLaw, PairForce, PairInput, PairKinematics};
 use crate::engine::{self, LawVisitor};
 use crate::io::FormatError;
@@ -85,6 +85,24 @@ impl LawVisitor for Boxed {
 /// The contact law of `case`.
 pub fn law_of(case: &Case) -> Box<dyn DynLaw> {
     engine::with_law(&case.contact, Boxed)
+}
+
+/// The two spheres' starting positions and radii, from the case's `spheres` scene (an error
+/// naming the file for any other scene).
+pub fn pair_of(case: &Case) -> anyhow::Result<([Vec3; 2], [f64; 2])> {
+    let sphere = match &case.scene {
+        Scene::Spheres { sphere } if sphere.len() == 2 => sphere,
+        _ => anyhow::bail!(
+            "{}: scene: a contact of two spheres needs `kind = \"spheres\"` with exactly two \
+             [[scene.sphere]]",
+            case.path.display()
+        ),
+    };
+    let r = |k: usize| sphere[k].radius.unwrap_or(0.5 * case.material.diameter);
+    Ok((
+        [Vec3::from(sphere[0].x), Vec3::from(sphere[1].x)],
+        [r(0), r(1)],
+    ))
 }
 
 /// Drives one contact of spheres with radii `radius` (sphere 1, sphere 2) through `rows`.

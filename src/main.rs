@@ -473,7 +473,7 @@ fn real_main() -> anyhow::Result<()> {
             let case = Case::load(&case)?;
             let (file, text) = verdem::io::read_text(&motion)?;
             let rows = verdem::kinematics::parse_motion(&file, &text)?;
-            let (_, radius) = verdem::verify::objectivity::pair_of(&case)?;
+            let (_, radius) = verdem::kinematics::pair_of(&case)?;
             let law = verdem::kinematics::law_of(&case);
             let forces = verdem::kinematics::drive(law.as_ref(), radius, &rows, increment);
             verdem::io::atomic::write(&out, verdem::kinematics::forces_csv(&forces).as_bytes())?;

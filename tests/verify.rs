@@ -119,7 +119,7 @@ fn a_closed_cycle_returns_the_objective_law_to_zero_force_and_ratchets_the_other
 fn the_kinematics_command_writes_the_forces_of_the_driver() {
     use verdem::kinematics::{drive, forces_csv, law_of, motion_csv, Increment};
     let case = load("objectivity.toml");
-    let (x, radius) = verdem::verify::objectivity::pair_of(&case).unwrap();
+    let (x, radius) = verdem::kinematics::pair_of(&case).unwrap();
     let mut rows = vec![verdem::kinematics::MotionRow {
         t: 0.0,
         x,

@@ -12,30 +12,12 @@
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 
 use super::{row_abs, Row};
-use crate::case::{Case, Scene, Tangential};
-use crate::kinematics::{drive, law_of, ForceRow, Increment, MotionRow};
+use crate::case::{Case, Tangential};
+use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
 use crate::Vec3;
 
 /// Steps of the rigid rotation per radian.
 const STEPS_PER_RADIAN: usize = 100_000;
-
-/// The two spheres' starting positions and radii, from the case's `spheres` scene (an error
-/// naming the file for any other scene).
-pub fn pair_of(case: &Case) -> anyhow::Result<([Vec3; 2], [f64; 2])> {
-    let sphere = match &case.scene {
-        Scene::Spheres { sphere } if sphere.len() == 2 => sphere,
-        _ => anyhow::bail!(
-            "{}: scene: a contact of two spheres needs `kind = \"spheres\"` with exactly two \
-             [[scene.sphere]]",
-            case.path.display()
-        ),
-    };
-    let r = |k: usize| sphere[k].radius.unwrap_or(0.5 * case.material.diameter);
-    Ok((
-        [Vec3::from(sphere[0].x), Vec3::from(sphere[1].x)],
-        [r(0), r(1)],
-    ))
-}
 
 /// Appends `steps` rows rotating the whole pair rigidly about `axis` through the origin by
 /// `angle`, starting from the last row.

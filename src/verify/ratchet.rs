@@ -15,10 +15,10 @@
 
 use nalgebra::{Unit, UnitQuaternion};
 
-use super::objectivity::{pair_of, rigid_rotation};
+use super::objectivity::rigid_rotation;
 use super::{row_abs, Row};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{drive, law_of, ForceRow, Increment, MotionRow};
+use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
 use crate::Vec3;
 
 /// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`,
