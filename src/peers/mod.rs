@@ -231,13 +231,21 @@ velocity        bottom set {vb:?} 0 0 units box\n\
 velocity        top    set {vt:?} 0 0 units box\n\
 fix             wbot bottom move linear {vb:?} 0 0\n\
 fix             wtop top    move linear {vt:?} 0 0\n\
-fix             integ free nve/sphere\n\
-{dump}\
-thermo          {steps}\n\
-run             {steps}\n",
+{}",
         case.name,
         setup_and_law(peer, case, data),
+        integrate_and_run(&dump, steps),
     ))
+}
+
+/// The free spheres integrated with `nve/sphere`, the dump commands, then the run.
+fn integrate_and_run(dump: &str, steps: u64) -> String {
+    format!(
+        "fix             integ free nve/sphere\n\
+{dump}\
+thermo          {steps}\n\
+run             {steps}\n"
+    )
 }
 
 /// An input script for `peer` running `steps` steps of a two-sphere `case` (a fixed sphere is
@@ -251,14 +259,11 @@ pub fn collision_script(peer: Peer, case: &Case, data: &str, steps: u64) -> Stri
 timestep        {dt:?}\n\
 fix             still1 bottom move linear 0 0 0\n\
 fix             still2 top    move linear 0 0 0\n\
-fix             integ free nve/sphere\n\
-{dump}\
-thermo          {steps}\n\
-run             {steps}\n",
+{}",
         case.name,
         setup_and_law(peer, case, data),
+        integrate_and_run(&dump_commands(peer, steps), steps),
         dt = case.dt(),
-        dump = dump_commands(peer, steps),
     )
 }
 

@@ -175,11 +175,7 @@ pub fn rows(base: &Case, steps: u64) -> anyhow::Result<Vec<Row>> {
         );
         let full_radius_lever =
             matches!(conv, Tangential::LammpsHookeHistory | Tangential::Cundall);
-        rows.push(if full_radius_lever {
-            r.documenting()
-        } else {
-            r
-        });
+        rows.push(r.gating_if(!full_radius_lever));
     }
     Ok(rows)
 }

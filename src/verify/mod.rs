@@ -42,35 +42,50 @@ impl Row {
         self.gate = false;
         self
     }
+
+    /// The same row, gating only when `gate` (a verdem claim), else documenting.
+    pub fn gating_if(self, gate: bool) -> Row {
+        if gate {
+            self
+        } else {
+            self.documenting()
+        }
+    }
 }
 
-/// A row judged by the relative error |measured − expected|/|expected|.
-pub fn row(case: &str, quantity: &str, expected: f64, measured: f64, tolerance: f64) -> Row {
-    let err = ((measured - expected) / expected).abs();
+fn judged(
+    case: &str,
+    quantity: &str,
+    expected: f64,
+    measured: f64,
+    tolerance: f64,
+    absolute: bool,
+) -> Row {
+    let err = if absolute {
+        (measured - expected).abs()
+    } else {
+        ((measured - expected) / expected).abs()
+    };
     Row {
         case: case.into(),
         quantity: quantity.into(),
         expected,
         measured,
         tolerance,
-        absolute: false,
+        absolute,
         pass: err <= tolerance,
         gate: true,
     }
 }
 
+/// A row judged by the relative error |measured − expected|/|expected|.
+pub fn row(case: &str, quantity: &str, expected: f64, measured: f64, tolerance: f64) -> Row {
+    judged(case, quantity, expected, measured, tolerance, false)
+}
+
 /// A row judged by the absolute error |measured − expected|.
 pub fn row_abs(case: &str, quantity: &str, expected: f64, measured: f64, tolerance: f64) -> Row {
-    Row {
-        case: case.into(),
-        quantity: quantity.into(),
-        expected,
-        measured,
-        tolerance,
-        absolute: true,
-        pass: (measured - expected).abs() <= tolerance,
-        gate: true,
-    }
+    judged(case, quantity, expected, measured, tolerance, true)
 }
 
 /// Every verification case of the folder `dir` (cases/verify): the table `verdem verify`

@@ -126,13 +126,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
         ] {
             let [dfn, dft, dir] = drifts(&case, axis)?;
             let name = format!("objectivity {} {label}", conv.name());
-            let gate = |r: Row| {
-                if conv == Tangential::Objective {
-                    r
-                } else {
-                    r.documenting()
-                }
-            };
+            let gate = |r: Row| r.gating_if(conv == Tangential::Objective);
             rows.push(gate(row_abs(&name, "Fn drift per rad", 0.0, dfn, 1e-6)));
             rows.push(gate(row_abs(&name, "|Ft| drift per rad", 0.0, dft, 1e-6)));
             rows.push(gate(row_abs(

@@ -120,13 +120,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             let twice = cycle(&case, axis, 2.0 * overlap, dx)?;
             let energy = c.peak * c.peak / (2.0 * case.contact.kt);
             let name = format!("ratchet {} {label}", conv.name());
-            let gate = |r: Row| {
-                if conv == Tangential::Objective {
-                    r
-                } else {
-                    r.documenting()
-                }
-            };
+            let gate = |r: Row| r.gating_if(conv == Tangential::Objective);
             let (res, work) = (c.residual / c.peak, c.work / energy);
             rows.push(gate(row_abs(
                 &name,
