@@ -25,9 +25,22 @@ fn err(file: &str, line: usize, msg: impl Into<String>) -> FormatError {
     }
 }
 
-/// Reads a dump file; errors name the file and line (a missing `ITEM:` line, other columns,
-/// ids not 1…N in order, a non-number).
-pub fn read(path: &Path) -> Result<Frame, FormatError> {
+/// A dump's header and its table: the step, the `ITEM:` line that names the columns, and the
+/// `count_item` rows of `columns` numbers each that follow it (line 10 on).
+struct Table {
+    step: u64,
+    names: String,
+    rows: Vec<Vec<f64>>,
+}
+
+/// Reads the header (`ITEM: TIMESTEP`, `count_item`, the box, `rows_item`) and the rows of a
+/// LAMMPS-style dump, naming the file and line of anything out of place.
+fn read_table(
+    path: &Path,
+    count_item: &str,
+    rows_item: &str,
+    columns: usize,
+) -> Result<(String, Table), FormatError> {
     let (file, text) = read_text(path)?;
     let lines: Vec<&str> = text.lines().collect();
     let item = |k: usize, name: &str| -> Result<&str, FormatError> {
@@ -44,73 +57,17 @@ pub fn read(path: &Path) -> Result<Frame, FormatError> {
     };
     item(0, "ITEM: TIMESTEP")?;
     let step = number(1)?;
-    item(2, "ITEM: NUMBER OF ATOMS")?;
+    item(2, count_item)?;
     let n = number(3)? as usize;
     item(4, "ITEM: BOX BOUNDS")?;
-    let atoms = item(8, "ITEM: ATOMS")?;
-    let cols: Vec<&str> = atoms.split_whitespace().skip(2).collect();
-    if cols != DUMP_COLUMNS {
-        return Err(err(
-            &file,
-            9,
-            format!("columns must be `{}`", DUMP_COLUMNS.join(" ")),
-        ));
-    }
-    let mut frame = Frame {
-        step,
-        radius: Vec::with_capacity(n),
-        x: Vec::with_capacity(n),
-        v: Vec::with_capacity(n),
-        w: Vec::with_capacity(n),
-    };
-    let mut nums = Vec::new();
-    for a in 0..n {
-        let k = 9 + a;
-        let line = lines
-            .get(k)
-            .ok_or_else(|| err(&file, k + 1, format!("{n} atoms announced, {a} found")))?;
-        parse_numbers(&file, k + 1, line, &mut nums)?;
-        if nums.len() != DUMP_COLUMNS.len() || nums[0] != (a + 1) as f64 {
-            return Err(err(
-                &file,
-                k + 1,
-                format!(
-                    "expected atom {} with {} columns",
-                    a + 1,
-                    DUMP_COLUMNS.len()
-                ),
-            ));
-        }
-        frame.radius.push(nums[2]);
-        frame.x.push(Vec3::new(nums[3], nums[4], nums[5]));
-        frame.v.push(Vec3::new(nums[6], nums[7], nums[8]));
-        frame.w.push(Vec3::new(nums[9], nums[10], nums[11]));
-    }
-    Ok(frame)
-}
-
-/// Reads a `dump local` file of `columns` numbers per entry (the contact forces of a save).
-pub fn read_entries(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> {
-    let (file, text) = read_text(path)?;
-    let lines: Vec<&str> = text.lines().collect();
-    let expect = |k: usize, name: &str| match lines.get(k) {
-        Some(l) if l.starts_with(name) => Ok(()),
-        _ => Err(err(&file, k + 1, format!("expected `{name}`"))),
-    };
-    expect(0, "ITEM: TIMESTEP")?;
-    expect(2, "ITEM: NUMBER OF ENTRIES")?;
-    let n: usize = lines
-        .get(3)
-        .and_then(|l| l.trim().parse().ok())
-        .ok_or_else(|| err(&file, 4, "expected a whole number"))?;
-    expect(8, "ITEM: ENTRIES")?;
-    let mut out = Vec::with_capacity(n);
+    let names = item(8, rows_item)?.to_string();
+    let mut rows = Vec::with_capacity(n);
     let mut nums = Vec::new();
     for e in 0..n {
         let k = 9 + e;
         let line = lines
             .get(k)
-            .ok_or_else(|| err(&file, k + 1, format!("{n} entries announced, {e} found")))?;
+            .ok_or_else(|| err(&file, k + 1, format!("{n} rows announced, {e} found")))?;
         parse_numbers(&file, k + 1, line, &mut nums)?;
         if nums.len() != columns {
             return Err(err(
@@ -119,9 +76,60 @@ pub fn read_entries(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, Format
                 format!("expected {columns} columns, got {}", nums.len()),
             ));
         }
-        out.push(nums.clone());
+        rows.push(nums.clone());
     }
-    Ok(out)
+    Ok((file, Table { step, names, rows }))
+}
+
+/// Reads a dump file; errors name the file and line (a missing `ITEM:` line, other columns,
+/// ids not 1…N in order, a non-number).
+pub fn read(path: &Path) -> Result<Frame, FormatError> {
+    let (file, t) = read_table(
+        path,
+        "ITEM: NUMBER OF ATOMS",
+        "ITEM: ATOMS",
+        DUMP_COLUMNS.len(),
+    )?;
+    let cols: Vec<&str> = t.names.split_whitespace().skip(2).collect();
+    if cols != DUMP_COLUMNS {
+        return Err(err(
+            &file,
+            9,
+            format!("columns must be `{}`", DUMP_COLUMNS.join(" ")),
+        ));
+    }
+    let n = t.rows.len();
+    let mut frame = Frame {
+        step: t.step,
+        radius: Vec::with_capacity(n),
+        x: Vec::with_capacity(n),
+        v: Vec::with_capacity(n),
+        w: Vec::with_capacity(n),
+    };
+    for (a, r) in t.rows.iter().enumerate() {
+        if r[0] != (a + 1) as f64 {
+            return Err(err(
+                &file,
+                10 + a,
+                format!(
+                    "expected atom {} with {} columns",
+                    a + 1,
+                    DUMP_COLUMNS.len()
+                ),
+            ));
+        }
+        frame.radius.push(r[2]);
+        frame.x.push(Vec3::new(r[3], r[4], r[5]));
+        frame.v.push(Vec3::new(r[6], r[7], r[8]));
+        frame.w.push(Vec3::new(r[9], r[10], r[11]));
+    }
+    Ok(frame)
+}
+
+/// Reads a `dump local` file of `columns` numbers per entry (the contact forces of a save).
+pub fn read_entries(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> {
+    let (_, t) = read_table(path, "ITEM: NUMBER OF ENTRIES", "ITEM: ENTRIES", columns)?;
+    Ok(t.rows)
 }
 
 #[cfg(test)]

@@ -61,6 +61,11 @@ pub fn spin_sphere_2(
     }
 }
 
+/// A unit axis in the tangent plane of the unit normal `n`: n × x, or y where n ∥ x.
+pub fn tangent_axis(n: Vec3) -> Vec3 {
+    n.cross(&Vec3::x()).try_normalize(1e-9).unwrap_or(Vec3::y())
+}
+
 /// Tangential part of the force on sphere 2.
 pub fn tangential_force(f: &ForceRow, n: Vec3) -> Vec3 {
     f.f[1] - f.f[1].dot(&n) * n
@@ -80,10 +85,7 @@ pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
     let n0 = (x[1] - x[0]).normalize();
     let fn0 = case.contact.kn * (radius[0] + radius[1] - (x[1] - x[0]).norm());
     // spin about a tangent axis until the spring carries ~ mu fn / 5
-    let tangent = n0
-        .cross(&Vec3::x())
-        .try_normalize(1e-9)
-        .unwrap_or(Vec3::y());
+    let tangent = tangent_axis(n0);
     let load = 0.2 * case.contact.mu * fn0 / case.contact.kt / radius[1];
     let mut rows = vec![start];
     spin_sphere_2(&mut rows, tangent, load, 100, 10, dt);
@@ -110,10 +112,7 @@ pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
 pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let (x, _) = pair_of(base)?;
     let n0 = (x[1] - x[0]).normalize();
-    let in_plane = n0
-        .cross(&Vec3::x())
-        .try_normalize(1e-9)
-        .unwrap_or(Vec3::y());
+    let in_plane = tangent_axis(n0);
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
         let mut case = base.clone();

@@ -15,7 +15,7 @@
 
 use nalgebra::{Unit, UnitQuaternion};
 
-use super::objectivity::rigid_rotation;
+use super::objectivity::{rigid_rotation, tangent_axis};
 use super::{row_abs, Row};
 use crate::case::{Case, Tangential};
 use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
@@ -70,10 +70,7 @@ pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<C
     let dt = case.dt();
     let n0 = (x[1] - x[0]).normalize();
     x[1] = x[0] + n0 * (radius[0] + radius[1] - overlap);
-    let orbit_axis = n0
-        .cross(&Vec3::x())
-        .try_normalize(1e-9)
-        .unwrap_or(Vec3::y());
+    let orbit_axis = tangent_axis(n0);
     let theta = dx / (radius[0] + radius[1]);
     let a = 0.1;
     let mut rows = vec![MotionRow {
@@ -101,10 +98,7 @@ pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<C
 pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let (x, radius) = pair_of(base)?;
     let n0 = (x[1] - x[0]).normalize();
-    let tangent = n0
-        .cross(&Vec3::x())
-        .try_normalize(1e-9)
-        .unwrap_or(Vec3::y());
+    let tangent = tangent_axis(n0);
     let along = tangent.cross(&n0);
     let overlap = radius[0] + radius[1] - (x[1] - x[0]).norm();
     // loads the spring to half the sliding limit at the case's overlap
