@@ -1,8 +1,9 @@
 //! Verlet pair list with a skin, built on a cell grid with periodic images.
 //!
-//! At every build the particles are re-ordered in memory by cell (x slowest), so that a thread
-//! owning a contiguous range of them owns a slab of space and touches few particles of the other
-//! threads. The order of floating-point sums never depends on that memory order: each pair is
+//! At every build the particles are re-ordered in memory by cell, the slowest axis a walled
+//! (non-periodic) one where there is one, so that a thread owning a contiguous range of them owns
+//! a slab of space with as few faces shared with other threads as the box allows (one in the
+//! shear case: the slabs are stacked between the walls) and touches few particles of theirs. The order of floating-point sums never depends on that memory order: each pair is
 //! oriented by original ids (P = lower id), and each particle's list of pairs is sorted by its
 //! partners' original ids.
 
@@ -32,6 +33,8 @@ pub struct PairList {
     /// each entry is `slot << 1 | role`, role 0 when `a` is P and 1 when `a` is I.
     pub adj_start: Vec<u32>,
     pub adj: Vec<u32>,
+    /// Scratch of [`PairList::index`]: `(particle, entry)` in the order of partner ids.
+    by_partner: Vec<(u32, u32)>,
 }
 
 /// Builder of pair lists; keeps its scratch buffers between builds.
@@ -44,7 +47,6 @@ pub struct NeighborBuilder {
     pub search: Search,
     keys: Vec<(u32, u32)>,
     cell_start: Vec<u32>,
-    partners: Vec<u32>,
 }
 
 impl NeighborBuilder {
@@ -57,11 +59,11 @@ impl NeighborBuilder {
             search,
             keys: Vec::new(),
             cell_start: Vec::new(),
-            partners: Vec::new(),
         }
     }
 
-    /// The memory order for positions `x`: indices sorted by (cell, id), x-axis slowest.
+    /// The memory order for positions `x`: indices sorted by (cell, id), cells in the grid's
+    /// axis order (a walled axis slowest).
     /// `order[new] = old`.
     pub fn order(&mut self, domain: &Domain, x: &[Vec3], id: &[u32], order: &mut Vec<u32>) {
         let grid = Grid::new(domain, self.cell);
@@ -125,26 +127,34 @@ impl NeighborBuilder {
                 for c in 0..grid.count() {
                     self.cell_start[c + 1] += self.cell_start[c];
                 }
-                let mut partners = std::mem::take(&mut self.partners);
-                for a in 0..n {
-                    partners.clear();
-                    grid.for_each_neighbour(grid.coords(domain, &x[a]), |nc| {
-                        let (s, e) = (
-                            self.cell_start[nc] as usize,
-                            self.cell_start[nc + 1] as usize,
-                        );
-                        for b in s.max(a + 1)..e {
-                            if accept(a, b) {
-                                partners.push(b as u32);
+                let mut near = [0usize; 27];
+                for c in 0..grid.count() {
+                    let (s, e) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
+                    if s == e {
+                        continue;
+                    }
+                    let mut count = 0;
+                    grid.for_each_neighbour(grid.cell_coords(c), |nc| {
+                        near[count] = nc;
+                        count += 1;
+                    });
+                    // Cells in index order hold increasing memory indices: each particle's
+                    // partners come out sorted.
+                    near[..count].sort_unstable();
+                    for a in s..e {
+                        for &nc in &near[..count] {
+                            let (s, e) = (
+                                self.cell_start[nc] as usize,
+                                self.cell_start[nc + 1] as usize,
+                            );
+                            for b in s.max(a + 1)..e {
+                                if accept(a, b) {
+                                    push(list, a, b);
+                                }
                             }
                         }
-                    });
-                    partners.sort_unstable();
-                    for &b in &partners {
-                        push(list, a, b as usize);
                     }
                 }
-                self.partners = partners;
             }
         }
     }
@@ -170,29 +180,41 @@ fn build_adjacency(list: &mut PairList, n: usize, id: &[u32], fill: &mut Vec<u32
     }
     list.adj.clear();
     list.adj.resize(list.adj_start[n] as usize, 0);
+    // Two stable counting sorts: every entry by its partner's id, then by its particle, so that
+    // each particle's entries come out in the order of partner ids.
+    fill.clear();
+    fill.resize(n + 1, 0);
+    for k in 0..list.p.len() {
+        for q in [list.p[k], list.i[k]] {
+            fill[id[q as usize] as usize + 1] += 1;
+        }
+    }
+    for a in 0..n {
+        fill[a + 1] += fill[a];
+    }
+    list.by_partner.clear();
+    list.by_partner.resize(list.adj.len(), (0, 0));
+    for k in 0..list.p.len() {
+        let (p, i) = (list.p[k], list.i[k]);
+        for (a, partner, role) in [(p, i, 0), (i, p, 1)] {
+            let at = &mut fill[id[partner as usize] as usize];
+            list.by_partner[*at as usize] = (a, ((k as u32) << 1) | role);
+            *at += 1;
+        }
+    }
     fill.clear();
     fill.extend_from_slice(&list.adj_start[..n]);
-    for k in 0..list.p.len() {
-        let (p, i) = (list.p[k] as usize, list.i[k] as usize);
-        list.adj[fill[p] as usize] = (k as u32) << 1;
-        fill[p] += 1;
-        list.adj[fill[i] as usize] = ((k as u32) << 1) | 1;
-        fill[i] += 1;
-    }
-    let (p, i) = (&list.p, &list.i);
-    let partner_id = |e: u32| {
-        let k = (e >> 1) as usize;
-        id[if e & 1 == 0 { i[k] } else { p[k] } as usize]
-    };
-    for a in 0..n {
-        let seg = &mut list.adj[list.adj_start[a] as usize..list.adj_start[a + 1] as usize];
-        seg.sort_unstable_by_key(|&e| partner_id(e));
+    for &(a, entry) in &list.by_partner {
+        list.adj[fill[a as usize] as usize] = entry;
+        fill[a as usize] += 1;
     }
 }
 
-/// Cell grid over the box; periodic axes wrap, others clamp. Cell index has x slowest.
+/// Cell grid over the box; periodic axes wrap, others clamp. Cell index runs over `axes`,
+/// slowest first: the longest non-periodic axis, if any, then the others in x, y, z order.
 struct Grid {
     n: [usize; 3],
+    axes: [usize; 3],
     inv_edge: [f64; 3],
     periodic: [bool; 3],
 }
@@ -206,8 +228,15 @@ impl Grid {
             n[k] = ((l[k] / cell).floor() as usize).max(1);
             inv_edge[k] = n[k] as f64 / l[k];
         }
+        let walled = (0..3)
+            .filter(|&k| !domain.periodic[k])
+            .max_by(|&a, &b| l[a].total_cmp(&l[b]).then(b.cmp(&a)));
+        let slow = walled.unwrap_or(0);
+        let mut rest = (0..3).filter(|&k| k != slow);
+        let axes = [slow, rest.next().unwrap(), rest.next().unwrap()];
         Grid {
             n,
+            axes,
             inv_edge,
             periodic: domain.periodic,
         }
@@ -215,6 +244,16 @@ impl Grid {
 
     fn count(&self) -> usize {
         self.n[0] * self.n[1] * self.n[2]
+    }
+
+    /// Coordinates of the cell of index `index` (the inverse of [`Grid::index`]).
+    fn cell_coords(&self, index: usize) -> [usize; 3] {
+        let [a, b, d] = self.axes;
+        let mut c = [0; 3];
+        c[d] = index % self.n[d];
+        c[b] = index / self.n[d] % self.n[b];
+        c[a] = index / self.n[d] / self.n[b];
+        c
     }
 
     fn coords(&self, domain: &Domain, x: &Vec3) -> [usize; 3] {
@@ -227,7 +266,8 @@ impl Grid {
     }
 
     fn index(&self, c: [usize; 3]) -> usize {
-        (c[0] * self.n[1] + c[1]) * self.n[2] + c[2]
+        let [a, b, d] = self.axes;
+        (c[a] * self.n[b] + c[b]) * self.n[d] + c[d]
     }
 
     /// Calls `f` once for each distinct cell adjacent to (or equal to) cell `c`.

@@ -3,8 +3,9 @@
 //! One step n → n+1 (MercuryDPM's order, `benchmark.md` "How MercuryDPM computes it"):
 //! 1. kick–drift of every free particle: v += (F/m + g)·dt/2, x += v·dt, ω += T/I·dt/2;
 //!    prescribed (wall) particles: x += v·dt; positions wrap along periodic axes;
-//! 2. the pair list is rebuilt when the displacement bound Σ max|v|·dt since the last build
-//!    exceeds half the skin (no pair can then have come closer than r_P + r_I unlisted);
+//! 2. the pair list is rebuilt when two particles may have closed a gap of a skin since the last
+//!    build (displacement bounds Σ max|v|·dt, one per speed class of the build), so that no pair
+//!    can have come closer than r_P + r_I unlisted;
 //! 3. pair forces at the new positions with the half-step velocities, each pair into its own
 //!    slot (its tangential history updated in place);
 //! 4. gather: each particle sums its slots in the order of its partners' ids; kick:
@@ -87,8 +88,9 @@ pub struct Core {
     pub out: Vec<PairForce>,
     /// Whether `particles.f`/`t` hold the forces of the current state.
     pub forces_ready: bool,
-    /// Upper bound of any particle's displacement since the last pair-list build (length).
-    pub moved_bound: f64,
+    /// Upper bounds of the displacement since the last pair-list build of any slow [0] and of
+    /// any fast [1] particle, by their speed class at that build (length).
+    pub moved_bound: [f64; 2],
     /// Worker threads of the step.
     pub threads: usize,
     /// Whether the force evaluation before the first step advances the tangential springs by
@@ -102,6 +104,14 @@ pub struct Core {
     /// Whether each particle (memory order) was within a skin of a periodic face at the last
     /// build; the others cannot cross one before the next build and skip the wrap.
     near_face: Vec<bool>,
+    /// Whether each particle (memory order) is quiet: its force and torque slots hold zero and
+    /// its velocities have absorbed a +0 kick (no −0 component), so that a free flight changes
+    /// neither and only drifts it. Cleared at every build and at the start of every run.
+    quiet: Vec<bool>,
+    /// Speed class of each particle (memory order) at the last build: 1 for the fast ones
+    /// (faster than [`SLOW_FRACTION`] of the fastest free particle, and all prescribed ones),
+    /// 0 for the others.
+    kind: Vec<u8>,
     builder: NeighborBuilder,
     scratch: Scratch,
 }
@@ -116,7 +126,10 @@ struct Scratch {
     old_keys: Vec<(u64, u32)>,
     old_xi: Vec<Vec3>,
     fill: Vec<u32>,
-    pair_keys: Vec<(bool, f64, u32)>,
+    /// Class and gap bin of each pair, `class · GAP_BINS + bin`, in build order.
+    bin: Vec<u8>,
+    /// Build-order index of each pair, in the order of the shares' bins.
+    sorted: Vec<u32>,
     particle_ranges: Vec<(usize, usize)>,
     /// Relative speed of each thread (work per second) in the particle pass [0] and in the
     /// pair pass [1], learnt from the busy times measured between builds: every pass ends at a
@@ -126,12 +139,27 @@ struct Scratch {
     range_weight: [Vec<u64>; 2],
     /// Each thread's pairs, before they are split into interior and boundary parts.
     pair_bounds: Vec<(usize, usize)>,
-    /// Each thread's pairs `(a, m, b)`: interior pairs `a..m`, then pairs across a periodic
-    /// boundary `m..b`, each part sorted by gap.
-    pair_ranges: Vec<(usize, usize, usize)>,
-    /// Gap |r| − (r_P + r_I) of each pair at the build (length).
+    /// Bounds of each thread's pair classes: class `c` is `ranges[c]..ranges[c + 1]`, each
+    /// sorted by gap bin (see [`CLASSES`]).
+    pair_ranges: Vec<[usize; CLASSES + 1]>,
+    /// Gap |r| − (r_P + r_I) of each pair at the build, rounded down to a sixteenth of the skin
+    /// (length).
     gap: Vec<f64>,
 }
+
+/// Gap bins of the pair list: one of overlapping pairs, then sixteen of a sixteenth of the skin
+/// each, and one more for the round-off at the cut.
+const GAP_BINS: usize = 18;
+
+/// Classes of pairs, each visited up to its own live end: `3·across + kind_P + kind_I`, where
+/// `across` marks a pair that may need a periodic image before the next build and the kinds are
+/// the particles' speed classes: a pair's gap closes at most by the sum of its particles' class
+/// displacement bounds, so pairs of slow particles are visited later.
+const CLASSES: usize = 6;
+
+/// A free particle is fast, at a build, when its speed exceeds this fraction of the fastest
+/// free particle's.
+const SLOW_FRACTION: f64 = 0.1;
 
 fn key(p: u32, i: u32) -> u64 {
     ((p as u64) << 32) | i as u64
@@ -161,12 +189,14 @@ impl Core {
             active: Vec::new(),
             out: Vec::new(),
             forces_ready: false,
-            moved_bound: 0.0,
+            moved_bound: [0.0; 2],
             threads,
             setup_advances_history: true,
             times: StageTimes::default(),
             touched: Vec::new(),
             near_face: Vec::new(),
+            quiet: Vec::new(),
+            kind: Vec::new(),
             builder,
             scratch: Scratch {
                 particle_ranges: vec![(0, 0); threads],
@@ -194,6 +224,8 @@ impl Core {
             times: &mut self.times,
             touched: &mut self.touched,
             near_face: &mut self.near_face,
+            quiet: &mut self.quiet,
+            kind: &mut self.kind,
         }
     }
 
@@ -202,7 +234,7 @@ impl Core {
         let domain = self.domain.clone();
         self.list_state()
             .rebuild(&domain, &[Vec::new(), Vec::new()]);
-        self.moved_bound = 0.0;
+        self.moved_bound = [0.0; 2];
     }
 
     /// Rebuilds the pair list and sets the given contacts (by original ids) as active with
@@ -371,11 +403,15 @@ impl<L: ContactLaw> Simulation<L> {
         let core = &mut self.core;
         let threads = core.threads;
         let barrier = SpinBarrier::new(threads);
-        let vmax2: Vec<AtomicU64> = (0..threads).map(|_| AtomicU64::new(0)).collect();
+        let vmax2: Vec<[AtomicU64; 2]> = (0..threads)
+            .map(|_| [AtomicU64::new(0), AtomicU64::new(0)])
+            .collect();
         let busy: [Vec<AtomicU64>; 2] =
             [0, 1].map(|_| (0..threads).map(|_| AtomicU64::new(0)).collect());
         let skin = core.skin();
         let bound0 = core.moved_bound;
+        // Velocities or forces may have been set since the last run.
+        core.quiet.fill(false);
         let domain = core.domain.clone();
         let view = StepView {
             law: &self.law,
@@ -401,8 +437,8 @@ impl<L: ContactLaw> Simulation<L> {
             // this thread's compute time in each pass since the last build (ns), for the load
             // balance
             let mut busy_local = [0u64; 2];
-            // Ends of the live prefixes of this thread's interior and boundary pairs.
-            let mut live: Option<(usize, usize)> = None;
+            // Ends of the live prefixes of this thread's pair classes.
+            let mut live: Option<[usize; CLASSES]> = None;
             for s in 0..steps {
                 // SAFETY (all blocks below): phases are separated by barriers; in each phase a
                 // thread writes only its own particle range or pair range, and a rebuild runs on
@@ -414,18 +450,25 @@ impl<L: ContactLaw> Simulation<L> {
                     particle_pass::<L, ROT, GRAV>(&view, l, a, b, s > 0, true)
                 };
                 busy_local[0] += t_start.elapsed().as_nanos() as u64;
-                vmax2[tid].store(v2.to_bits(), Ordering::Relaxed);
+                for (slot, v) in vmax2[tid].iter().zip(v2) {
+                    slot.store(v.to_bits(), Ordering::Relaxed);
+                }
                 lap(&mut local.integrate);
                 barrier.wait();
                 lap(&mut local.wait);
-                // Every thread derives the same bound from the same numbers.
-                let m = vmax2
-                    .iter()
-                    .map(|a| f64::from_bits(a.load(Ordering::Relaxed)))
-                    .fold(0.0, f64::max);
-                bound += m.sqrt() * view.dt;
-                if bound > 0.5 * skin {
-                    bound = 0.0;
+                // Every thread derives the same bounds from the same numbers.
+                for (kind, b) in bound.iter_mut().enumerate() {
+                    let m = vmax2
+                        .iter()
+                        .map(|a| f64::from_bits(a[kind].load(Ordering::Relaxed)))
+                        .fold(0.0, f64::max);
+                    *b += m.sqrt() * view.dt;
+                }
+                // How far a slow–slow [0], slow–fast [1] and fast–fast [2] pair can have closed
+                // its gap.
+                let closed = [2.0 * bound[0], bound[0] + bound[1], 2.0 * bound[1]];
+                if closed.into_iter().fold(0.0, f64::max) > skin {
+                    bound = [0.0; 2];
                     live = None;
                     for pass in 0..2 {
                         busy[pass][tid].store(busy_local[pass], Ordering::Relaxed);
@@ -440,22 +483,26 @@ impl<L: ContactLaw> Simulation<L> {
                 }
                 unsafe {
                     let l = list.get();
-                    let (a, m, b) = l.scratch.pair_ranges[tid];
-                    let (mut li, mut lb) = live.unwrap_or((a, m));
-                    // A pair whose gap at the build exceeds twice the displacement bound cannot
-                    // touch yet; its slot stays inactive, exactly as a full pass would leave it.
-                    let reach = 2.0 * bound + 1e-9;
+                    let seg = l.scratch.pair_ranges[tid];
+                    let ends = live.get_or_insert([seg[0], seg[1], seg[2], seg[3], seg[4], seg[5]]);
+                    // A pair whose gap at the build exceeds what its particles can have closed
+                    // cannot touch yet; its slot stays inactive, exactly as a full pass would
+                    // leave it.
                     let gap = &l.scratch.gap;
-                    while li < m && gap[li] <= reach {
-                        li += 1;
+                    for (c, end) in ends.iter_mut().enumerate() {
+                        let reach = closed[c % 3] + 1e-9;
+                        while *end < seg[c + 1] && gap[*end] <= reach {
+                            *end += 1;
+                        }
                     }
-                    while lb < b && gap[lb] <= reach {
-                        lb += 1;
-                    }
-                    live = Some((li, lb));
                     let t_start = Instant::now();
-                    pair_pass::<L, false>(&view, l, a, li);
-                    pair_pass::<L, true>(&view, l, m, lb);
+                    for c in 0..CLASSES {
+                        if c < CLASSES / 2 {
+                            pair_pass::<L, false>(&view, l, seg[c], ends[c]);
+                        } else {
+                            pair_pass::<L, true>(&view, l, seg[c], ends[c]);
+                        }
+                    }
                     busy_local[1] += t_start.elapsed().as_nanos() as u64;
                 }
                 lap(&mut local.forces);
@@ -506,6 +553,8 @@ struct ListState<'a> {
     times: &'a mut StageTimes,
     touched: &'a mut Vec<AtomicBool>,
     near_face: &'a mut Vec<bool>,
+    quiet: &'a mut Vec<bool>,
+    kind: &'a mut Vec<u8>,
 }
 
 fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
@@ -556,6 +605,17 @@ impl ListState<'_> {
         // All clear between a particle pass and a pair pass; only the length can change.
         self.touched
             .resize_with(pt.len(), || AtomicBool::new(false));
+        self.quiet.clear();
+        self.quiet.resize(pt.len(), false);
+        let fastest = (0..pt.len())
+            .filter(|&a| pt.inv_mass[a] > 0.0)
+            .map(|a| pt.v[a].norm())
+            .fold(0.0, f64::max);
+        let slow = SLOW_FRACTION * fastest;
+        self.kind.clear();
+        self.kind.extend(
+            (0..pt.len()).map(|a| u8::from(pt.inv_mass[a] == 0.0 || pt.v[a].norm() > slow)),
+        );
         // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
         let threads = s.particle_ranges.len();
         for pass in 0..2 {
@@ -588,9 +648,12 @@ impl ListState<'_> {
         pair_weight.clear();
         pair_weight.extend(s.pair_bounds.iter().map(|&(a, b)| 2 * (b - a) as u64));
         // Within a share, interior pairs (no periodic image needed until the next build) come
-        // first, then the others; each part sorted by gap, so that a step visits only the
-        // prefix of pairs whose gap the particles can have closed (see `live`).
+        // first, then the others; each part in bins of gap (GAP_BINS − 1 bins of a sixteenth of
+        // the skin, after one of all overlapping pairs), each bin in build (owner memory) order.
+        // A step visits only the prefix of bins whose gap the particles can have closed (see
+        // `live`), in near-memory order.
         let skin = self.builder.skin;
+        let bin_width = skin / 16.0;
         let interior = |a: usize| {
             (0..3).all(|k| {
                 !domain.periodic[k]
@@ -599,38 +662,61 @@ impl ListState<'_> {
         };
         self.near_face.clear();
         self.near_face.extend((0..pt.len()).map(|a| !interior(a)));
-        s.pair_keys.clear();
+        s.bin.clear();
         for k in 0..n_pairs {
             let (p, i) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
             let direct = pt.x[p] - pt.x[i];
             let r = domain.min_image(direct);
             let cut = pt.radius[p] + pt.radius[i] + skin;
-            let plain = interior(p)
-                && interior(i)
+            let plain = !self.near_face[p]
+                && !self.near_face[i]
                 && r == direct
                 && (0..3).all(|k| !domain.periodic[k] || cut + skin < 0.5 * domain.lengths()[k]);
-            s.pair_keys
-                .push((!plain, r.norm() - (pt.radius[p] + pt.radius[i]), k as u32));
+            let gap = r.norm() - (pt.radius[p] + pt.radius[i]);
+            let bin = if skin > 0.0 {
+                ((gap / bin_width).floor() + 1.0).clamp(0.0, (GAP_BINS - 1) as f64) as usize
+            } else {
+                0
+            };
+            let class =
+                3 * usize::from(!plain) + usize::from(self.kind[p]) + usize::from(self.kind[i]);
+            s.bin.push((class * GAP_BINS + bin) as u8);
         }
+        // A stable counting sort of each share by (class, bin).
+        s.sorted.clear();
+        s.sorted.resize(n_pairs, 0);
+        s.gap.clear();
+        s.gap.resize(n_pairs, 0.0);
         s.pair_ranges.clear();
         for &(pa, pb) in &s.pair_bounds {
-            let part = &mut s.pair_keys[pa..pb];
-            part.sort_unstable_by(|x, y| {
-                x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(x.2.cmp(&y.2))
-            });
-            let m = pa + part.iter().take_while(|e| !e.0).count();
-            s.pair_ranges.push((pa, m, pb));
+            let mut next = [0usize; CLASSES * GAP_BINS];
+            for &b in &s.bin[pa..pb] {
+                next[b as usize] += 1;
+            }
+            let mut at = pa;
+            for (b, n) in next.iter_mut().enumerate() {
+                let count = *n;
+                *n = at;
+                // Lower edge of the bin; overlapping pairs (bin 0) are always visited.
+                s.gap[at..at + count].fill((b % GAP_BINS) as f64 * bin_width - bin_width);
+                at += count;
+            }
+            let mut ranges = [pb; CLASSES + 1];
+            for (c, r) in ranges.iter_mut().take(CLASSES).enumerate() {
+                *r = next[c * GAP_BINS];
+            }
+            s.pair_ranges.push(ranges);
+            for k in pa..pb {
+                let slot = &mut next[s.bin[k] as usize];
+                s.sorted[*slot] = k as u32;
+                *slot += 1;
+            }
         }
-        s.gap.clear();
-        s.gap.extend(s.pair_keys.iter().map(|e| e.1));
-        s.index.clear();
-        s.index
-            .extend(s.pair_keys.iter().map(|e| self.pairs.p[e.2 as usize]));
-        std::mem::swap(&mut self.pairs.p, &mut s.index);
-        s.index.clear();
-        s.index
-            .extend(s.pair_keys.iter().map(|e| self.pairs.i[e.2 as usize]));
-        std::mem::swap(&mut self.pairs.i, &mut s.index);
+        for list in [&mut self.pairs.p, &mut self.pairs.i] {
+            s.index.clear();
+            s.index.extend(s.sorted.iter().map(|&k| list[k as usize]));
+            std::mem::swap(list, &mut s.index);
+        }
         self.pairs.index(pt.len(), self.id, &mut s.fill);
         self.xi.clear();
         self.xi.resize(n_pairs, Vec3::zeros());
@@ -664,22 +750,32 @@ impl ListState<'_> {
 
 /// Per-particle pass over `a..b`: with `kick_end`, gather the forces of the step that just
 /// ended and apply the closing half kick; with `drift`, apply the opening half kick and the drift
-/// of the next step. Returns the largest squared speed after the drift.
+/// of the next step. Returns the largest squared speed after the drift of a slow [0] and of a
+/// fast [1] particle (speed classes of the last build).
 ///
 /// # Safety
 /// Writes particles `a..b` only; reads pair outputs, which no one writes in this phase.
 #[inline(never)]
 unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     view: &StepView<'_, L>,
-    l: &ListState<'_>,
+    l: &mut ListState<'_>,
     a: usize,
     b: usize,
     kick_end: bool,
     drift: bool,
-) -> f64 {
+) -> [f64; 2] {
     let pt = view.particles.get();
     let dt = view.dt;
-    let mut vmax2: f64 = 0.0;
+    // Four running maxima of each kind, one per lane j mod 4: a single one would chain every
+    // particle's comparison to the previous one's.
+    let mut vmax2 = [[0.0f64; 4]; 2];
+    let mut see = |class: usize, j: usize, vp: Vec3| {
+        let s2 = vp.norm_squared();
+        let lane = &mut vmax2[class][j & 3];
+        if s2 > *lane {
+            *lane = s2;
+        }
+    };
     // Plain slices of this thread's range: bounds and base pointers stay in registers.
     let x = &mut pt.x[a..b];
     let v = &mut pt.v[a..b];
@@ -690,6 +786,8 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     let inv_inertia = &pt.inv_inertia[a..b];
     let touched = &l.touched[a..b];
     let near_face = &l.near_face[a..b];
+    let kind = &l.kind[a..b];
+    let quiet = &mut l.quiet[a..b];
     // Each particle's values are loaded once into locals and stored once: a store followed by
     // an overlapping wider load of the same vector stalls store forwarding.
     for j in 0..x.len() {
@@ -706,20 +804,24 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
             let contact = kick_end && touched[j].load(Ordering::Relaxed);
             if !GRAV && kick_end && !contact {
                 // Free flight: F = T = 0 exactly, so both half kicks add +0; (v + 0) + 0 = v + 0
-                // bit for bit, which this path computes once.
-                f[j] = Vec3::zeros();
-                t[j] = Vec3::zeros();
-                let vp = v[j] + Vec3::zeros();
-                if drift {
-                    x[j] = drift_to(vp, x[j]);
-                    vmax2 = vmax2.max(vp.norm_squared());
+                // bit for bit, which is v itself once v has absorbed one +0 (quiet).
+                if !quiet[j] {
+                    f[j] = Vec3::zeros();
+                    t[j] = Vec3::zeros();
+                    v[j] += Vec3::zeros();
+                    if ROT {
+                        w[j] += Vec3::zeros();
+                    }
+                    quiet[j] = true;
                 }
-                v[j] = vp;
-                if ROT {
-                    w[j] += Vec3::zeros();
+                if drift {
+                    let vp = v[j];
+                    x[j] = drift_to(vp, x[j]);
+                    see(kind[j] as usize, j, vp);
                 }
                 continue;
             }
+            quiet[j] = false;
             let (fp, tp) = if kick_end {
                 let g = if contact {
                     touched[j].store(false, Ordering::Relaxed);
@@ -749,7 +851,7 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
             if drift {
                 vp += dv;
                 x[j] = drift_to(vp, x[j]);
-                vmax2 = vmax2.max(vp.norm_squared());
+                see(kind[j] as usize, j, vp);
             }
             v[j] = vp;
             if ROT {
@@ -766,10 +868,10 @@ unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
         } else if drift {
             let vp = v[j];
             x[j] = drift_to(vp, x[j]);
-            vmax2 = vmax2.max(vp.norm_squared());
+            see(kind[j] as usize, j, vp);
         }
     }
-    vmax2
+    vmax2.map(|lanes| lanes.into_iter().fold(0.0, f64::max))
 }
 
 /// Sum of the forces and torques of particle `a`'s active pairs, in the order of partner ids.
