@@ -7,6 +7,7 @@ pub mod checks;
 pub mod fields;
 pub mod kernel;
 pub mod plot;
+pub mod table;
 
 use std::path::{Path, PathBuf};
 
@@ -17,6 +18,7 @@ use crate::domain::Domain;
 use crate::io::mercury;
 use fields::{derive, raw_fields, Derived, Grid, Raw};
 use kernel::Kernel;
+use table::Table;
 
 /// What to coarse-grain and how.
 #[derive(Clone, Debug)]
@@ -163,23 +165,17 @@ pub const FIELDS: [(&str, usize); 5] = [
     ("shear", 25),
 ];
 
-/// χ²/dof of profile `col` of `a` against `b` over the core slices: the mean of
+/// χ²/dof of profile `col` of `a` against `b` (same grid) over the core slices: the mean of
 /// (a − b)²/(se_a² + se_b²), ≈ 1 when they differ by noise only.
 pub fn chi2(a: &Profiles, b: &Profiles, col: usize) -> f64 {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for k in core_range(&a.grid) {
-        let (ca, cb) = (columns(&a.mean[k])[col], columns(&b.mean[k])[col]);
-        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
-        if var > 0.0 {
-            sum += (ca - cb).powi(2) / var;
-            n += 1;
-        }
-    }
-    if n == 0 {
-        0.0
-    } else {
-        sum / n as f64
-    }
+    table::chi2(&Table::of(a), &Table::of(b), col, core_window(&a.grid))
+        .expect("profiles of one grid")
+}
+
+/// The z-interval of the core: at least two diameters from the walls' surfaces (z ∈ [3, 19]
+/// for the benchmark's box [0, 22]).
+pub fn core_window(grid: &Grid) -> (f64, f64) {
+    (grid.z0 + 3.0, grid.z1 - 3.0)
 }
 
 /// Column names of [`columns`] (after `z`).
@@ -327,10 +323,9 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     })
 }
 
-/// Grid points of the core: at least two diameters from the walls' surfaces (z ∈ [3, 19] for
-/// the benchmark's box [0, 22]).
+/// Grid points of the core (see [`core_window`]).
 pub fn core_range(grid: &Grid) -> std::ops::Range<usize> {
-    let (lo, hi) = (grid.z0 + 3.0, grid.z1 - 3.0);
+    let (lo, hi) = core_window(grid);
     let first = (0..grid.n).find(|&k| grid.z(k) >= lo).unwrap_or(0);
     let last = (0..grid.n)
         .rev()
@@ -405,22 +400,7 @@ pub fn integrated_autocorrelation(x: &[f64]) -> f64 {
 
 /// The profiles as CSV: z, then every column of [`COLUMNS`] followed by its standard error.
 pub fn csv(p: &Profiles) -> String {
-    let mut s = String::from("z");
-    for c in COLUMNS {
-        s.push_str(&format!(",{c},{c}_se"));
-    }
-    s.push('\n');
-    for k in 0..p.grid.n {
-        crate::io::fmt_f64(&mut s, p.grid.z(k));
-        for (c, v) in columns(&p.mean[k]).iter().enumerate() {
-            s.push(',');
-            crate::io::fmt_f64(&mut s, *v);
-            s.push(',');
-            crate::io::fmt_f64(&mut s, p.se[k][c]);
-        }
-        s.push('\n');
-    }
-    s
+    Table::of(p).csv()
 }
 
 /// Coarse-grains `base` and writes `NAME.profiles.csv`, `NAME.profiles.png` and

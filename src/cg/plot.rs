@@ -5,7 +5,8 @@ use std::path::Path;
 use anyhow::Context;
 use plotters::prelude::*;
 
-use super::{columns, Profiles, COLUMNS};
+use super::table::Table;
+use super::{Profiles, COLUMNS};
 
 /// The TrueType font used for labels (Debian package `fonts-dejavu-core`).
 pub const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -34,8 +35,8 @@ pub struct Curve<'a> {
     pub se: Vec<f64>,
 }
 
-/// The curves of the five benchmark panels for one set of profiles.
-pub fn benchmark_curves(p: &Profiles) -> Vec<(String, Curve<'static>)> {
+/// The curves of the five benchmark panels for one table of profiles, labelled `label`.
+pub fn benchmark_curves<'a>(t: &Table, label: &'a str) -> Vec<(String, Curve<'a>)> {
     let panels = [
         ("vx", "velocity vx"),
         ("nu", "volume fraction"),
@@ -43,7 +44,6 @@ pub fn benchmark_curves(p: &Profiles) -> Vec<(String, Curve<'static>)> {
         ("pressure", "pressure"),
         ("shear_xz", "shear stress xz"),
     ];
-    let z: Vec<f64> = (0..p.grid.n).map(|k| p.grid.z(k)).collect();
     panels
         .iter()
         .map(|(col, title)| {
@@ -51,10 +51,10 @@ pub fn benchmark_curves(p: &Profiles) -> Vec<(String, Curve<'static>)> {
             (
                 title.to_string(),
                 Curve {
-                    label: "",
-                    z: z.clone(),
-                    value: p.mean.iter().map(|d| columns(d)[c]).collect(),
-                    se: p.se.iter().map(|s| s[c]).collect(),
+                    label,
+                    z: t.z.clone(),
+                    value: t.mean.iter().map(|m| m[c]).collect(),
+                    se: t.se.iter().map(|s| s[c]).collect(),
                 },
             )
         })
@@ -140,9 +140,19 @@ fn draw(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> 
 
 /// The five benchmark profiles of one run.
 pub fn profiles_png(p: &Profiles, path: &Path) -> anyhow::Result<()> {
-    let panels: Vec<(String, Vec<Curve<'_>>)> = benchmark_curves(p)
-        .into_iter()
-        .map(|(t, c)| (t, vec![c]))
-        .collect();
+    overlay_png(&[("", &Table::of(p))], path)
+}
+
+/// The five benchmark profiles of several runs, one labelled curve per run in each panel.
+pub fn overlay_png(runs: &[(&str, &Table)], path: &Path) -> anyhow::Result<()> {
+    let mut panels: Vec<(String, Vec<Curve<'_>>)> = Vec::new();
+    for (label, t) in runs {
+        for (k, (title, curve)) in benchmark_curves(t, label).into_iter().enumerate() {
+            if k == panels.len() {
+                panels.push((title, Vec::new()));
+            }
+            panels[k].1.push(curve);
+        }
+    }
     panels_png(&panels, path)
 }

@@ -6,8 +6,9 @@
 //! integrate the same equations; what remains is the summation order of forces, so the
 //! trajectories agree to round-off at first and part by chaos later. The step at which the
 //! largest position difference first exceeds 1e-6 measures that onset. Both series are written
-//! as MercuryCG `.data` saves, verdem's also with its `.fstat` (so `verdem cg` reads it); the
-//! peers' contact forces are not converted yet.
+//! as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its pair/local dumps),
+//! coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`, overlaid in
+//! `profiles.png`, and compared profile by profile (χ²/dof).
 
 use std::fmt::Write;
 use std::path::Path;
@@ -16,7 +17,7 @@ use anyhow::{ensure, Context};
 
 use super::{dump, input_script, run, Peer};
 use crate::case::{Case, Tangential};
-use crate::cg;
+use crate::cg::{self, table::Table};
 use crate::contact::PairForce;
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
@@ -255,6 +256,16 @@ pub fn cross(
         cg::coarse_grain(&series(&own_dir)?, &o)?,
         cg::coarse_grain(&series(&peer_dir)?, &o)?,
     );
+    let (own_table, their_table) = (Table::of(&own), Table::of(&theirs));
+    atomic::write(
+        &out.join(format!("{}.profiles.csv", peer.binary())),
+        their_table.csv().as_bytes(),
+    )?;
+    atomic::write(&out.join("verdem.profiles.csv"), own_table.csv().as_bytes())?;
+    cg::plot::overlay_png(
+        &[(peer.binary(), &their_table), ("verdem", &own_table)],
+        &out.join("profiles.png"),
+    )?;
     let report = Report {
         peer,
         np,

@@ -1,0 +1,175 @@
+//! Profiles as a table of numbers: written as CSV, read back (golden peer profiles are stored
+//! this way), and compared slice by slice against their combined standard errors.
+
+use crate::io::{read_text, FormatError};
+
+use super::{columns, Profiles, COLUMNS};
+
+/// Profiles at grid points `z`: for each point, every column of [`COLUMNS`] and its standard
+/// error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    pub z: Vec<f64>,
+    pub mean: Vec<Vec<f64>>,
+    pub se: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// The table of coarse-grained profiles.
+    pub fn of(p: &Profiles) -> Table {
+        Table {
+            z: (0..p.grid.n).map(|k| p.grid.z(k)).collect(),
+            mean: p.mean.iter().map(columns).collect(),
+            se: p.se.clone(),
+        }
+    }
+
+    /// The CSV text: z, then every column of [`COLUMNS`] followed by its standard error.
+    pub fn csv(&self) -> String {
+        let mut s = header();
+        s.push('\n');
+        for k in 0..self.z.len() {
+            crate::io::fmt_f64(&mut s, self.z[k]);
+            for (v, e) in self.mean[k].iter().zip(&self.se[k]) {
+                s.push(',');
+                crate::io::fmt_f64(&mut s, *v);
+                s.push(',');
+                crate::io::fmt_f64(&mut s, *e);
+            }
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Reads a table written by [`Table::csv`]; a wrong header or a bad number is reported
+    /// with the file, line and column.
+    pub fn read(path: &std::path::Path) -> Result<Table, FormatError> {
+        let (file, text) = read_text(path)?;
+        let fail = |line: usize, msg: String| FormatError {
+            file: file.clone(),
+            line,
+            msg,
+        };
+        let mut lines = text.lines();
+        if lines.next() != Some(header().as_str()) {
+            return Err(fail(1, "not a profiles table (unexpected header)".into()));
+        }
+        let mut table = Table {
+            z: Vec::new(),
+            mean: Vec::new(),
+            se: Vec::new(),
+        };
+        for (n, line) in lines.enumerate() {
+            let line_no = n + 2;
+            let mut row = Vec::with_capacity(1 + 2 * COLUMNS.len());
+            for (col, tok) in line.split(',').enumerate() {
+                let name = if col == 0 {
+                    "z".to_string()
+                } else {
+                    let c = COLUMNS[(col - 1).min(COLUMNS.len() * 2 - 1) / 2];
+                    if col % 2 == 1 {
+                        c.to_string()
+                    } else {
+                        format!("{c}_se")
+                    }
+                };
+                let v: f64 = tok
+                    .trim()
+                    .parse()
+                    .map_err(|_| fail(line_no, format!("field {name}: not a number: {tok:?}")))?;
+                row.push(v);
+            }
+            if row.len() != 1 + 2 * COLUMNS.len() {
+                return Err(fail(
+                    line_no,
+                    format!("{} fields, expected {}", row.len(), 1 + 2 * COLUMNS.len()),
+                ));
+            }
+            table.z.push(row[0]);
+            table
+                .mean
+                .push(row[1..].iter().step_by(2).copied().collect());
+            table.se.push(row[2..].iter().step_by(2).copied().collect());
+        }
+        if table.z.is_empty() {
+            return Err(fail(2, "no rows".into()));
+        }
+        Ok(table)
+    }
+}
+
+/// The CSV header line (without its newline).
+fn header() -> String {
+    let mut s = String::from("z");
+    for c in COLUMNS {
+        s.push_str(&format!(",{c},{c}_se"));
+    }
+    s
+}
+
+/// χ²/dof of column `col` of `a` against `b` over the grid points with z in `window`: the mean
+/// of (a − b)²/(se_a² + se_b²), ≈ 1 when they differ by noise only. Both tables must have the
+/// same grid.
+pub fn chi2(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Result<f64> {
+    anyhow::ensure!(
+        a.z.len() == b.z.len() && a.z.iter().zip(&b.z).all(|(x, y)| (x - y).abs() < 1e-9),
+        "the profiles are on different grids ({} and {} points)",
+        a.z.len(),
+        b.z.len()
+    );
+    let (mut sum, mut n) = (0.0, 0usize);
+    for k in 0..a.z.len() {
+        if a.z[k] < window.0 || a.z[k] > window.1 {
+            continue;
+        }
+        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
+        if var > 0.0 {
+            sum += (a.mean[k][col] - b.mean[k][col]).powi(2) / var;
+            n += 1;
+        }
+    }
+    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(shift: f64) -> Table {
+        let z: Vec<f64> = (0..10).map(|k| k as f64 + 0.5).collect();
+        Table {
+            mean: z
+                .iter()
+                .map(|z| (0..COLUMNS.len()).map(|c| z * c as f64 + shift).collect())
+                .collect(),
+            se: z.iter().map(|_| vec![0.5; COLUMNS.len()]).collect(),
+            z,
+        }
+    }
+
+    #[test]
+    fn tables_round_trip_and_chi2_sees_a_shift() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.csv");
+        std::fs::write(&path, table(0.0).csv()).unwrap();
+        let back = Table::read(&path).unwrap();
+        assert_eq!(back, table(0.0));
+        assert_eq!(chi2(&back, &table(0.0), 3, (0.0, 10.0)).unwrap(), 0.0);
+        // a shift of one combined standard error (√0.5) gives χ²/dof = 1 on every point
+        let one = chi2(&back, &table(0.5f64.sqrt()), 3, (2.0, 8.0)).unwrap();
+        assert!((one - 1.0).abs() < 1e-12, "{one}");
+    }
+
+    #[test]
+    fn a_bad_field_is_named_with_its_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.csv");
+        let text = table(0.0).csv().replacen(",0.5,", ",zero,", 1);
+        std::fs::write(&path, text).unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(e.contains("p.csv:2: field ") && e.contains("zero"), "{e}");
+        std::fs::write(&path, "z,vx\n1,2\n").unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(e.contains("p.csv:1: not a profiles table"), "{e}");
+    }
+}
