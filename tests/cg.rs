@@ -218,17 +218,7 @@ fn coarse_grains_a_series_verdem_wrote() {
         Some(&common::shared("states/mercury_t143.85.data")),
         Default::default(),
     );
-    let opts = verdem::run::RunOptions {
-        end_step: 2000,
-        save_every: 500,
-        checkpoint_every: 0,
-        out_dir: dir.path().to_path_buf(),
-        name: "s".into(),
-        tag: "s".into(),
-        progress: false,
-        write_saves: true,
-    };
-    verdem::run::run(e.as_mut(), &opts, false).unwrap();
+    common::run_with_saves(e.as_mut(), dir.path(), "s", 2000, 500);
     let mut o = options(480, KernelChoice::Heaviside);
     o.slices = 100;
     let (p, report) = cg::write_all(&dir.path().join("s"), &o).unwrap();

@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use verdem::engine::Overrides;
-use verdem::run::{self, RunOptions};
+use verdem::run;
 
 fn golden(name: &str, how: &str, body: String) {
     insta::with_settings!({
@@ -37,17 +37,7 @@ fn short_run(
                 ..Overrides::default()
             },
         );
-        let opts = RunOptions {
-            end_step: steps,
-            save_every,
-            checkpoint_every: 0,
-            out_dir: dir.path().to_path_buf(),
-            name: "g".into(),
-            tag: "g".into(),
-            progress: false,
-            write_saves: true,
-        };
-        let s = run::run(e.as_mut(), &opts, false).unwrap();
+        let s = run_with_saves(e.as_mut(), dir.path(), "g", steps, save_every);
         let last = steps / save_every;
         let head = |ext: &str, n: usize| -> String {
             std::fs::read_to_string(run::save_path(dir.path(), "g", ext, last))

@@ -40,3 +40,25 @@ pub fn hash_after(engine: &mut dyn Engine, steps: u64) -> String {
     engine.advance(steps);
     verdem::hash::state_hash(&engine.core().snapshot())
 }
+
+/// Runs `engine` to step `end_step` with a save every `save_every` into `dir`, saves named
+/// `name`, no progress bar and no checkpoints.
+pub fn run_with_saves(
+    engine: &mut dyn Engine,
+    dir: &Path,
+    name: &str,
+    end_step: u64,
+    save_every: u64,
+) -> verdem::run::RunSummary {
+    let opts = verdem::run::RunOptions {
+        end_step,
+        save_every,
+        checkpoint_every: 0,
+        out_dir: dir.to_path_buf(),
+        name: name.into(),
+        tag: name.into(),
+        progress: false,
+        write_saves: true,
+    };
+    verdem::run::run(engine, &opts, false).expect("run")
+}
