@@ -19,7 +19,7 @@ if [ ! -f "$OUT/$NAME.summary.toml" ]; then
 fi
 G=golden/full_run
 mkdir -p "$G"
-LAST=$(grep '^step' "$OUT/$NAME.summary.toml" | awk '{print $3}')
+LAST=$(grep '^step =' "$OUT/$NAME.summary.toml" | awk '{print $3}')
 SAVE=$(printf '%04d' $((LAST / 50000)))
 cp "$OUT/$NAME.data.$SAVE" "$G/$NAME.final.data"
 for f in profiles.csv profiles.png checks.txt summary.toml diagnostics.csv; do
