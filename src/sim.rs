@@ -484,7 +484,7 @@ impl<L: ContactLaw> Simulation<L> {
                 unsafe {
                     let l = list.get();
                     let seg = l.scratch.pair_ranges[tid];
-                    let ends = live.get_or_insert([seg[0], seg[1], seg[2], seg[3], seg[4], seg[5]]);
+                    let ends = live.get_or_insert_with(|| std::array::from_fn(|c| seg[c]));
                     // A pair whose gap at the build exceeds what its particles can have closed
                     // cannot touch yet; its slot stays inactive, exactly as a full pass would
                     // leave it.
