@@ -6,7 +6,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 
 use verdem::case::Case;
-use verdem::cg::{self, CgOptions, KernelChoice};
+use verdem::cg::{self, table::Table, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
 use verdem::run::{self, RunOptions};
 use verdem::{bench, checkpoint, hash, scene};
@@ -130,6 +130,15 @@ enum Command {
         /// Where the peers' collision runs go.
         #[arg(long, default_value = "out/verify")]
         out: PathBuf,
+    },
+    /// Compare profiles tables (`verdem cg` output, e.g. golden/peers/*.profiles.csv) with a
+    /// reference over the core: χ²/dof and relative RMS difference of each benchmark profile.
+    Compare {
+        /// The reference table.
+        reference: PathBuf,
+        /// The tables to compare with it (same grid).
+        #[arg(required = true)]
+        others: Vec<PathBuf>,
     },
     /// Run LAMMPS or LIGGGHTS and verdem (with the peer's tangential convention) on the same
     /// case and state; compare positions, velocities and spins at every save; write both
@@ -448,6 +457,18 @@ fn real_main() -> anyhow::Result<()> {
             )?;
             print!("{}", report.markdown());
             println!("(saves and tables in {})", out.display());
+        }
+        Command::Compare { reference, others } => {
+            let read = |p: &PathBuf| -> anyhow::Result<(String, Table)> {
+                Ok((p.display().to_string(), Table::read(p)?))
+            };
+            let (name, table) = read(&reference)?;
+            let others = others
+                .iter()
+                .map(read)
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let rows = verdem::cg::compare::compare(&table, &others)?;
+            print!("{}", verdem::cg::compare::markdown(&name, &rows));
         }
         Command::Tradeoff {
             case,

@@ -4,6 +4,7 @@
 //! and a plot. Any code's output in this format is judged by the same yardstick.
 
 pub mod checks;
+pub mod compare;
 pub mod fields;
 pub mod kernel;
 pub mod plot;

@@ -3,7 +3,7 @@
 
 use crate::io::{read_text, FormatError};
 
-use super::{columns, Profiles, COLUMNS};
+use super::{columns, Grid, Profiles, COLUMNS};
 
 /// Profiles at grid points `z`: for each point, every column of [`COLUMNS`] and its standard
 /// error.
@@ -22,6 +22,19 @@ impl Table {
             mean: p.mean.iter().map(columns).collect(),
             se: p.se.clone(),
         }
+    }
+
+    /// The grid of the table's points: uniform slices with the points at their centres, as
+    /// [`Table::of`] writes them (at least two points).
+    pub fn grid(&self) -> anyhow::Result<Grid> {
+        let n = self.z.len();
+        anyhow::ensure!(n >= 2, "a profiles table needs two grid points, it has {n}");
+        let h = (self.z[n - 1] - self.z[0]) / (n - 1) as f64;
+        Ok(Grid {
+            z0: self.z[0] - h / 2.0,
+            z1: self.z[n - 1] + h / 2.0,
+            n,
+        })
     }
 
     /// The CSV text: z, then every column of [`COLUMNS`] followed by its standard error.

@@ -1,0 +1,135 @@
+//! Profiles of several codes or runs against a reference, over the core: per benchmark profile,
+//! the χ²/dof of the difference in units of the combined standard error (≈ 1: noise; ≫ 1:
+//! bias, or errors that miss slow fluctuations) and the relative RMS difference (how large the
+//! difference is, whatever its significance).
+
+use std::fmt::Write;
+
+use super::table::{chi2, Table};
+use super::{core_window, FIELDS};
+
+/// One table against the reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    pub name: String,
+    /// χ²/dof of each profile of [`FIELDS`] against the reference, core slices only.
+    pub chi2: [f64; 5],
+    /// √mean((a − ref)²) / √mean(ref²) of each profile over the core slices (dimensionless).
+    pub rel_rms: [f64; 5],
+}
+
+/// √mean((a − b)²) / √mean(b²) of column `col` over the grid points with z in `window`; the
+/// tables must share the grid (checked by [`chi2`]).
+fn relative_rms(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> f64 {
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for k in 0..a.z.len() {
+        if (window.0..=window.1).contains(&a.z[k]) {
+            diff += (a.mean[k][col] - b.mean[k][col]).powi(2);
+            norm += b.mean[k][col].powi(2);
+        }
+    }
+    if norm > 0.0 {
+        (diff / norm).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Compares each of `others` with `reference` over the core of the reference's grid.
+pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<Vec<Comparison>> {
+    let window = core_window(&reference.grid()?);
+    others
+        .iter()
+        .map(|(name, t)| {
+            let mut c = Comparison {
+                name: name.clone(),
+                chi2: [0.0; 5],
+                rel_rms: [0.0; 5],
+            };
+            for (f, &(_, col)) in FIELDS.iter().enumerate() {
+                c.chi2[f] = chi2(t, reference, col, window)?;
+                c.rel_rms[f] = relative_rms(t, reference, col, window);
+            }
+            Ok(c)
+        })
+        .collect()
+}
+
+/// The comparisons as a markdown table, one row per table.
+pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
+    let names: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
+    let mut s = format!(
+        "Against `{reference}`, core slices: χ²/dof (1 = noise) | relative RMS difference\n\n\
+         | profiles | {} | {} |\n|---|{}\n",
+        names
+            .iter()
+            .map(|n| format!("χ² {n}"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        names
+            .iter()
+            .map(|n| format!("rms {n}"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---|".repeat(2 * names.len())
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} |",
+            r.name,
+            r.chi2
+                .iter()
+                .map(|c| format!("{c:.2}"))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            r.rel_rms
+                .iter()
+                .map(|c| format!("{:.2} %", 100.0 * c))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cg::COLUMNS;
+
+    /// A 100-slice table over [0, 22] whose every column is `value` with standard error `se`.
+    fn flat(value: f64, se: f64) -> Table {
+        let z: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 0.22).collect();
+        Table {
+            mean: z.iter().map(|_| vec![value; COLUMNS.len()]).collect(),
+            se: z.iter().map(|_| vec![se; COLUMNS.len()]).collect(),
+            z,
+        }
+    }
+
+    #[test]
+    fn a_shift_of_one_combined_error_gives_chi2_one_and_its_relative_size() {
+        let reference = flat(2.0, 0.03);
+        let shifted = flat(2.0 + 0.03 * 2f64.sqrt(), 0.03);
+        let rows = compare(&reference, &[("shifted".into(), shifted)]).unwrap();
+        for f in 0..5 {
+            assert!((rows[0].chi2[f] - 1.0).abs() < 1e-9, "{:?}", rows[0]);
+            assert!((rows[0].rel_rms[f] - 0.03 * 2f64.sqrt() / 2.0).abs() < 1e-12);
+        }
+        let md = markdown("ref", &rows);
+        assert!(md.contains("| shifted | 1.00 |"), "{md}");
+    }
+
+    #[test]
+    fn only_the_core_counts() {
+        let reference = flat(1.0, 0.1);
+        let mut near_walls = flat(1.0, 0.1);
+        for k in (0..13).chain(87..100) {
+            near_walls.mean[k] = vec![5.0; COLUMNS.len()];
+        }
+        let rows = compare(&reference, &[("walls".into(), near_walls)]).unwrap();
+        assert_eq!(rows[0].chi2, [0.0; 5]);
+        assert_eq!(rows[0].rel_rms, [0.0; 5]);
+    }
+}
