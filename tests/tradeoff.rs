@@ -42,6 +42,13 @@ fn variants_change_what_they_should_and_nothing_else() {
         );
         assert!(o.steps < reference.steps, "{name}");
     }
+    // the replica repeats the reference's physics over the next stretch: same law and cost,
+    // other bits, and a χ² that measures the noise floor
+    let replica = by(verdem::tradeoff::REPLICA);
+    assert_eq!(replica.steps, reference.steps);
+    assert_eq!(replica.restitution_error, reference.restitution_error);
+    assert_ne!(replica.hash, reference.hash);
+    assert!(replica.chi2.iter().all(|&c| c > 0.0), "{:?}", replica.chi2);
     let table = verdem::tradeoff::markdown(&out);
-    assert_eq!(table.lines().count(), 2 + 9);
+    assert_eq!(table.lines().count(), 2 + 10);
 }
