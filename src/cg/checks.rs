@@ -1,5 +1,6 @@
 //! Built-in physics checks of steady-state profiles: momentum balance, wall consistency, mass,
-//! symmetry, and a kinetic-theory sanity check (reported, never failed).
+//! symmetry, steadiness across the blocks of saves, and a kinetic-theory sanity check
+//! (reported, never failed).
 
 use super::{columns, core_range, standard_error, Profiles, COLUMNS};
 
@@ -30,6 +31,44 @@ fn uniformity(v: &[f64], se: &[f64]) -> (f64, f64) {
         .map(|(x, s)| ((x - mean) / s.max(1e-300)).powi(2))
         .sum::<f64>();
     (mean, chi2 / (v.len() as f64 - 1.0).max(1.0))
+}
+
+/// Least-squares line through equally spaced values `y`: its change from the first to the last
+/// point relative to the mean, and its slope in units of the slope's standard error (from the
+/// residuals; ±∞ for an exact line, 0 for fewer than three points or constant values).
+fn trend(y: &[f64]) -> (f64, f64) {
+    let n = y.len() as f64;
+    if y.len() < 3 {
+        return (0.0, 0.0);
+    }
+    let x_mean = (n - 1.0) / 2.0;
+    let y_mean = y.iter().sum::<f64>() / n;
+    let sxx: f64 = (0..y.len()).map(|i| (i as f64 - x_mean).powi(2)).sum();
+    let slope = y
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (i as f64 - x_mean) * (v - y_mean))
+        .sum::<f64>()
+        / sxx;
+    let residual: f64 = y
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (v - y_mean - slope * (i as f64 - x_mean)).powi(2))
+        .sum();
+    let se = (residual / (n - 2.0) / sxx).sqrt();
+    let change = if y_mean != 0.0 {
+        slope * (n - 1.0) / y_mean
+    } else {
+        0.0
+    };
+    let t = if se > 0.0 {
+        slope / se
+    } else if slope == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY.copysign(slope)
+    };
+    (change, t)
 }
 
 /// Runs every check. `density` is the particle density (for the kinetic-theory check).
@@ -169,7 +208,31 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             pass: Some(chi < limit),
         });
     }
-    // 5. Kinetic theory: p/(ρp ν T) against 1 + 2(1+e) ν g0(ν), Carnahan–Starling g0 (reported).
+    // 5. Steadiness: no trend of the core's fluctuation energy ½ tr σ_kin across the blocks.
+    let energy: Vec<f64> = p
+        .block_columns
+        .iter()
+        .map(|b| {
+            core.clone()
+                .map(|k| 0.5 * (b[k][col("kin_xx")] + b[k][col("kin_yy")] + b[k][col("kin_zz")]))
+                .sum::<f64>()
+                / core.len() as f64
+        })
+        .collect();
+    let (change, t) = trend(&energy);
+    out.push(Check {
+        name: format!(
+            "steady: core fluctuation energy density has no trend across the {} blocks",
+            energy.len()
+        ),
+        measured: format!(
+            "linear change {:+.2} % over the saves, {t:+.2} standard errors",
+            100.0 * change
+        ),
+        expected: "|trend| < 3 standard errors (reported only with fewer than 4 blocks)".into(),
+        pass: (energy.len() >= 4).then_some(t.abs() < 3.0),
+    });
+    // 6. Kinetic theory: p/(ρp ν T) against 1 + 2(1+e) ν g0(ν), Carnahan–Starling g0 (reported).
     let e = 0.902;
     let ratios: Vec<f64> = core
         .clone()
@@ -221,4 +284,27 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::trend;
+
+    #[test]
+    fn a_trend_is_measured_against_its_scatter() {
+        // exact line 10, 11, …, 14: a rise of 4 over a mean of 12, with no scatter
+        let (change, t) = trend(&[10.0, 11.0, 12.0, 13.0, 14.0]);
+        assert!((change - 4.0 / 12.0).abs() < 1e-12, "{change}");
+        assert_eq!(t, f64::INFINITY, "an exact line is a trend");
+        assert_eq!(trend(&[3.0; 5]), (0.0, 0.0));
+        // alternating scatter of ±1 around a flat line: no trend
+        let (change, t) = trend(&[1.0, -1.0, 1.0, -1.0, 1.0, -1.0].map(|v| 10.0 + v));
+        assert!(change.abs() < 0.15 && t.abs() < 1.0, "{change} {t}");
+        // a clear rise through scatter
+        let y: Vec<f64> = (0..10)
+            .map(|i| 10.0 + i as f64 + if i % 2 == 0 { 0.3 } else { -0.3 })
+            .collect();
+        let (_, t) = trend(&y);
+        assert!(t > 10.0, "{t}");
+    }
 }
