@@ -1,4 +1,5 @@
-//! Criterion benchmarks: the pair-force kernel, the pair-list rebuild, one full time step of
+//! Criterion benchmarks: the pair-force kernel (with MercuryDPM's friction, and the frictionless
+//! law a `mu = 0` case runs), the pair-list rebuild, one full time step of
 //! MercuryDPM's developed shear state (1 and 2 threads), and the coarse-graining of one save.
 //! Needs `../shared/data` beside the repository. Run: `cargo bench`.
 
@@ -10,7 +11,8 @@ use verdem::case::Case;
 use verdem::cg::fields::{raw_fields, Grid};
 use verdem::cg::kernel::Kernel;
 use verdem::contact::{
-    ContactLaw, LinearSpringDashpot, MercuryLaw, MercurySlidingFriction, PairInput,
+    ContactLaw, Frictionless, FrictionlessLaw, LinearSpringDashpot, MercuryLaw,
+    MercurySlidingFriction, PairInput,
 };
 use verdem::engine::{self, Overrides};
 use verdem::sim::Engine;
@@ -62,6 +64,17 @@ fn pair_kernel(c: &mut Criterion) {
         b.iter(|| {
             let k = black_box(&input).kinematics().unwrap();
             black_box(law.evaluate(&k, &mut xi, 7.192545031528827e-05))
+        })
+    });
+    let frictionless: FrictionlessLaw = verdem::contact::Composed {
+        normal: law.normal,
+        tangential: Frictionless,
+    };
+    c.bench_function("pair force (kinematics + frictionless law, mu = 0)", |b| {
+        let mut xi = Vec3::zeros();
+        b.iter(|| {
+            let k = black_box(&input).kinematics().unwrap();
+            black_box(frictionless.evaluate(&k, &mut xi, 7.192545031528827e-05))
         })
     });
 }

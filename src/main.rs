@@ -139,6 +139,13 @@ enum Command {
         /// The tables to compare with it (same grid).
         #[arg(required = true)]
         others: Vec<PathBuf>,
+        /// Also overlay all the tables' profiles (±2 SE bands) in this PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Labels of the tables in the plot and the table, reference first (default: the
+        /// file names).
+        #[arg(long, value_delimiter = ',')]
+        labels: Vec<String>,
     },
     /// Run LAMMPS or LIGGGHTS and verdem (with the peer's tangential convention) on the same
     /// case and state; compare positions, velocities and spins at every save; write both
@@ -458,17 +465,35 @@ fn real_main() -> anyhow::Result<()> {
             print!("{}", report.markdown());
             println!("(saves and tables in {})", out.display());
         }
-        Command::Compare { reference, others } => {
-            let read = |p: &PathBuf| -> anyhow::Result<(String, Table)> {
-                Ok((p.display().to_string(), Table::read(p)?))
-            };
-            let (name, table) = read(&reference)?;
-            let others = others
-                .iter()
-                .map(read)
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            let rows = verdem::cg::compare::compare(&table, &others)?;
-            print!("{}", verdem::cg::compare::markdown(&name, &rows));
+        Command::Compare {
+            reference,
+            others,
+            plot,
+            labels,
+        } => {
+            let paths: Vec<&PathBuf> = std::iter::once(&reference).chain(&others).collect();
+            anyhow::ensure!(
+                labels.is_empty() || labels.len() == paths.len(),
+                "--labels: {} labels for {} tables",
+                labels.len(),
+                paths.len()
+            );
+            let mut tables = Vec::new();
+            for (k, p) in paths.iter().enumerate() {
+                let label = labels
+                    .get(k)
+                    .cloned()
+                    .unwrap_or_else(|| p.display().to_string());
+                tables.push((label, Table::read(p)?));
+            }
+            let rows = verdem::cg::compare::compare(&tables[0].1, &tables[1..])?;
+            print!("{}", verdem::cg::compare::markdown(&tables[0].0, &rows));
+            if let Some(png) = plot {
+                let runs: Vec<(&str, &Table)> =
+                    tables.iter().map(|(l, t)| (l.as_str(), t)).collect();
+                cg::plot::overlay_png(&runs, &png)?;
+                println!("(overlay in {})", png.display());
+            }
         }
         Command::Tradeoff {
             case,
