@@ -1,17 +1,28 @@
 //! A persistent team of threads for the time step: every thread runs the same step loop on its
-//! own share of the work (SPMD) and they meet at spinning barriers between phases. A step of
-//! this small system takes tens of microseconds, so a fork–join per phase (rayon) would cost a
-//! large fraction of it; a spin barrier costs well under a microsecond.
+//! own share of the work (SPMD) and they meet at barriers between phases. A step of this small
+//! system takes tens of microseconds, so a fork–join per phase (rayon) would cost a large
+//! fraction of it; a spinning barrier costs well under a microsecond.
 
 use std::cell::UnsafeCell;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
-/// A reusable sense-reversing barrier for a fixed number of threads. Threads spin briefly and
-/// then yield, so an oversubscribed machine still makes progress.
+/// How long a thread spins at a barrier before it sleeps: longer than the waits of a balanced
+/// step on an idle machine (a few microseconds), far shorter than a scheduler time slice.
+const SPIN: Duration = Duration::from_micros(10);
+
+/// A reusable barrier for a fixed number of threads. Threads spin for up to [`SPIN`], then
+/// sleep on a futex until the last one arrives. On an idle machine nobody sleeps but a thread
+/// waiting out a pair-list rebuild; on a busy one (more runnable threads than cores) a thread
+/// whose partner has lost its core gives its own core back instead of spinning through its
+/// time slice, which would stall every step for milliseconds.
 pub struct SpinBarrier {
     threads: usize,
     waiting: AtomicUsize,
-    sense: AtomicBool,
+    /// Rounds completed; the futex the sleepers wait on.
+    round: AtomicU32,
+    /// Threads asleep, or about to sleep, on `round`.
+    sleepers: AtomicU32,
 }
 
 impl SpinBarrier {
@@ -19,7 +30,8 @@ impl SpinBarrier {
         SpinBarrier {
             threads,
             waiting: AtomicUsize::new(0),
-            sense: AtomicBool::new(false),
+            round: AtomicU32::new(0),
+            sleepers: AtomicU32::new(0),
         }
     }
 
@@ -29,20 +41,38 @@ impl SpinBarrier {
         if self.threads == 1 {
             return;
         }
-        let sense = !self.sense.load(Ordering::Relaxed);
+        // No thread can complete this round before this one arrives: `round` is current.
+        let round = self.round.load(Ordering::Acquire);
         if self.waiting.fetch_add(1, Ordering::AcqRel) + 1 == self.threads {
             self.waiting.store(0, Ordering::Relaxed);
-            self.sense.store(sense, Ordering::Release);
-        } else {
-            let mut spins = 0u32;
-            while self.sense.load(Ordering::Acquire) != sense {
-                if spins < 20_000 {
-                    std::hint::spin_loop();
-                    spins += 1;
-                } else {
-                    std::thread::yield_now();
-                }
+            // SeqCst with the load of `sleepers` below and the sleepers' increment before their
+            // futex check: either the last thread sees a sleeper and wakes it, or the sleeper's
+            // futex check sees the new round and returns at once.
+            self.round.store(round.wrapping_add(1), Ordering::SeqCst);
+            if self.sleepers.load(Ordering::SeqCst) > 0 {
+                atomic_wait::wake_all(&self.round);
             }
+            return;
+        }
+        let start = Instant::now();
+        let mut spins = 0u32;
+        while self.round.load(Ordering::Acquire) == round {
+            spins = spins.wrapping_add(1);
+            if spins % 64 == 0 && start.elapsed() > SPIN {
+                self.sleep(round);
+                return;
+            }
+            std::hint::spin_loop();
+        }
+    }
+
+    /// Sleeps until `round` has passed.
+    #[cold]
+    fn sleep(&self, round: u32) {
+        while self.round.load(Ordering::Acquire) == round {
+            self.sleepers.fetch_add(1, Ordering::SeqCst);
+            atomic_wait::wait(&self.round, round);
+            self.sleepers.fetch_sub(1, Ordering::SeqCst);
         }
     }
 }
@@ -140,5 +170,30 @@ mod tests {
                 });
             }
         });
+    }
+
+    #[test]
+    fn barrier_orders_phases_when_threads_sleep() {
+        // One thread in three is late by more than the spin time every few rounds, so the
+        // others take the futex path; the phases stay ordered and nobody is left asleep.
+        let barrier = SpinBarrier::new(3);
+        let counter = AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            for tid in 0..3 {
+                let (barrier, counter) = (&barrier, &counter);
+                s.spawn(move || {
+                    for round in 0..200 {
+                        if tid == round % 3 && round % 4 == 0 {
+                            std::thread::sleep(4 * SPIN);
+                        }
+                        counter.fetch_add(1, Ordering::Relaxed);
+                        barrier.wait();
+                        assert_eq!(counter.load(Ordering::Relaxed), 3 * (round + 1));
+                        barrier.wait();
+                    }
+                });
+            }
+        });
+        assert_eq!(barrier.sleepers.load(Ordering::Relaxed), 0);
     }
 }
