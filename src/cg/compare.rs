@@ -1,7 +1,8 @@
 //! Profiles of several codes or runs against a reference, over the core: per benchmark profile,
 //! the χ²/dof of the difference in units of the combined standard error (≈ 1: noise; ≫ 1:
-//! bias, or errors that miss slow fluctuations) and the relative RMS difference (how large the
-//! difference is, whatever its significance).
+//! bias, or errors that miss slow fluctuations) and the difference of the core means relative
+//! to the reference's mean magnitude (how large a systematic difference is; the slices' noise
+//! averages down in it).
 
 use std::fmt::Write;
 
@@ -14,22 +15,23 @@ pub struct Comparison {
     pub name: String,
     /// χ²/dof of each profile of [`FIELDS`] against the reference, core slices only.
     pub chi2: [f64; 5],
-    /// √mean((a − ref)²) / √mean(ref²) of each profile over the core slices (dimensionless).
-    pub rel_rms: [f64; 5],
+    /// Σ(a − ref) / Σ|ref| of each profile over the core slices (dimensionless, signed).
+    pub rel_mean: [f64; 5],
 }
 
-/// √mean((a − b)²) / √mean(b²) of column `col` over the grid points with z in `window`; the
-/// tables must share the grid (checked by [`chi2`]).
-fn relative_rms(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> f64 {
+/// Σ(a − b) / Σ|b| of column `col` over the grid points with z in `window`: the difference of
+/// the core means relative to `b`'s mean magnitude; the tables must share the grid (checked by
+/// [`chi2`]).
+fn relative_mean_difference(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> f64 {
     let (mut diff, mut norm) = (0.0, 0.0);
     for k in 0..a.z.len() {
         if (window.0..=window.1).contains(&a.z[k]) {
-            diff += (a.mean[k][col] - b.mean[k][col]).powi(2);
-            norm += b.mean[k][col].powi(2);
+            diff += a.mean[k][col] - b.mean[k][col];
+            norm += b.mean[k][col].abs();
         }
     }
     if norm > 0.0 {
-        (diff / norm).sqrt()
+        diff / norm
     } else {
         0.0
     }
@@ -44,11 +46,11 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
             let mut c = Comparison {
                 name: name.clone(),
                 chi2: [0.0; 5],
-                rel_rms: [0.0; 5],
+                rel_mean: [0.0; 5],
             };
             for (f, &(_, col)) in FIELDS.iter().enumerate() {
                 c.chi2[f] = chi2(t, reference, col, window)?;
-                c.rel_rms[f] = relative_rms(t, reference, col, window);
+                c.rel_mean[f] = relative_mean_difference(t, reference, col, window);
             }
             Ok(c)
         })
@@ -59,7 +61,8 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
 pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     let names: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
     let mut s = format!(
-        "Against `{reference}`, core slices: χ²/dof (1 = noise) | relative RMS difference\n\n\
+        "Against `{reference}`, core slices: χ²/dof (1 = noise) | difference of the core means \
+         relative to the reference's\n\n\
          | profiles | {} | {} |\n|---|{}\n",
         names
             .iter()
@@ -68,7 +71,7 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
             .join(" | "),
         names
             .iter()
-            .map(|n| format!("rms {n}"))
+            .map(|n| format!("Δ {n}"))
             .collect::<Vec<_>>()
             .join(" | "),
         "---|".repeat(2 * names.len())
@@ -83,9 +86,9 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
                 .map(|c| format!("{c:.2}"))
                 .collect::<Vec<_>>()
                 .join(" | "),
-            r.rel_rms
+            r.rel_mean
                 .iter()
-                .map(|c| format!("{:.2} %", 100.0 * c))
+                .map(|c| format!("{:+.2} %", 100.0 * c))
                 .collect::<Vec<_>>()
                 .join(" | ")
         );
@@ -115,7 +118,7 @@ mod tests {
         let rows = compare(&reference, &[("shifted".into(), shifted)]).unwrap();
         for f in 0..5 {
             assert!((rows[0].chi2[f] - 1.0).abs() < 1e-9, "{:?}", rows[0]);
-            assert!((rows[0].rel_rms[f] - 0.03 * 2f64.sqrt() / 2.0).abs() < 1e-12);
+            assert!((rows[0].rel_mean[f] - 0.03 * 2f64.sqrt() / 2.0).abs() < 1e-12);
         }
         let md = markdown("ref", &rows);
         assert!(md.contains("| shifted | 1.00 |"), "{md}");
@@ -130,6 +133,6 @@ mod tests {
         }
         let rows = compare(&reference, &[("walls".into(), near_walls)]).unwrap();
         assert_eq!(rows[0].chi2, [0.0; 5]);
-        assert_eq!(rows[0].rel_rms, [0.0; 5]);
+        assert_eq!(rows[0].rel_mean, [0.0; 5]);
     }
 }
