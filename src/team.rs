@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 /// How long a thread spins at a barrier before it sleeps: longer than the waits of a balanced
 /// step on an idle machine (a few microseconds), far shorter than a scheduler time slice.
-const SPIN: Duration = Duration::from_micros(10);
+const SPIN: Duration = Duration::from_micros(50);
 
 /// A reusable barrier for a fixed number of threads. Threads spin for up to [`SPIN`], then
 /// sleep on a futex until the last one arrives. On an idle machine nobody sleeps but a thread
