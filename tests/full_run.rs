@@ -4,6 +4,12 @@
 //! windows of the same length of the full run itself do (golden/full_run/window_chi2.toml, made
 //! by ci/window_chi2.sh: the block errors of a short series miss the flow's slow fluctuations,
 //! so χ²/dof of the same physics is well above 1).
+//!
+//! The peers' long runs from that state (golden/peers/, made by ci/record_peers.sh: LAMMPS and
+//! LIGGGHTS, and verdem itself, 1e7 steps each) are judged with the same yardstick: the short
+//! run must match each peer's profiles as it matches verdem's steady ones, and its saves must be
+//! the first saves of the stored verdem run, bit for bit, so that the stored run is today's
+//! code's.
 
 mod common;
 
@@ -13,6 +19,10 @@ use verdem::engine::Overrides;
 
 fn golden(name: &str) -> std::path::PathBuf {
     common::root().join("golden/full_run").join(name)
+}
+
+fn peers(name: &str) -> std::path::PathBuf {
+    common::root().join("golden/peers").join(name)
 }
 
 /// The value of `key = "…"` in the provenance file.
@@ -41,7 +51,7 @@ fn chi2s(a: &Table, b: &Table, window: (f64, f64)) -> Vec<(&'static str, f64)> {
 }
 
 #[test]
-fn a_short_run_from_the_final_state_matches_the_steady_profiles() {
+fn a_short_run_from_the_final_state_matches_the_steady_profiles_and_the_peers() {
     let case = common::quick_case();
     let mut e = common::engine(
         &case,
@@ -70,6 +80,28 @@ fn a_short_run_from_the_final_state_matches_the_steady_profiles() {
             limit(name)
         );
     }
+    for peer in ["lammps", "liggghts"] {
+        let theirs = Table::read(&peers(&format!("{peer}.profiles.csv"))).unwrap();
+        for (name, c) in chi2s(&short, &theirs, window) {
+            assert!(
+                c < limit(name),
+                "{name}: chi2/dof {c:.2} against {peer}'s profiles (limit {:.2})",
+                limit(name)
+            );
+        }
+    }
+    let diagnostics = |path: &std::path::Path| -> Vec<String> {
+        let text = std::fs::read_to_string(path).unwrap();
+        text.lines().map(str::to_string).collect()
+    };
+    let ours = diagnostics(&dir.path().join("s.diagnostics.csv"));
+    let stored = diagnostics(&peers("verdem.diagnostics.csv"));
+    assert_eq!(ours.len() as u64, SAVES + 2, "header and saves 0..={SAVES}");
+    assert_eq!(
+        ours[..],
+        stored[..ours.len()],
+        "the short run's saves are not the stored verdem run's first saves"
+    );
     // The yardstick can fail: the same short run against steady profiles whose core velocity is
     // off by 0.05 (5 % of the wall speed).
     let mut shifted = steady.clone();
@@ -83,6 +115,77 @@ fn a_short_run_from_the_final_state_matches_the_steady_profiles() {
         "a 0.05 shift of vx gives only chi2/dof {c:.2}"
     );
 }
+
+/// The long runs of golden/peers all start from the full run's final state and run the same
+/// steps; verdem's own law (MercuryDPM's tangential convention) deviates from each peer's
+/// profiles no more than 1.5 times as much as the runs of the peers' laws — LAMMPS, LIGGGHTS,
+/// and verdem in each peer's convention — deviate from one another (the largest χ²/dof of their
+/// six pairs, at least 1): at this length their differences are the flow's slow fluctuations,
+/// which even two runs of the same equations show (golden/peers/compare.md).
+#[test]
+fn the_peers_long_runs_match_verdems_own() {
+    let start = provenance("final_state_sha256");
+    let mut steps = Vec::new();
+    for name in ["lammps", "liggghts", "verdem"] {
+        let text = std::fs::read_to_string(peers(&format!("{name}.toml"))).unwrap();
+        let t: toml::Table = toml::from_str(&text).unwrap();
+        assert_eq!(
+            t["start_state_sha256"].as_str(),
+            Some(start.as_str()),
+            "{name}"
+        );
+        steps.push(t["steps"].as_integer().unwrap());
+    }
+    assert!(
+        steps.iter().all(|&s| s == steps[0] && s >= 10_000_000),
+        "{steps:?}"
+    );
+    let table = |name: &str| Table::read(&peers(&format!("{name}.profiles.csv"))).unwrap();
+    let ours = table("verdem");
+    let window = cg::core_window(&ours.grid().unwrap());
+    let peer_laws: Vec<Table> = [
+        "lammps",
+        "liggghts",
+        "verdem_as_lammps",
+        "verdem_as_liggghts",
+    ]
+    .iter()
+    .map(|n| table(n))
+    .collect();
+    let mut spread = [1.0f64; 5];
+    for a in 0..peer_laws.len() {
+        for b in a + 1..peer_laws.len() {
+            for (f, (_, c)) in chi2s(&peer_laws[a], &peer_laws[b], window)
+                .into_iter()
+                .enumerate()
+            {
+                spread[f] = spread[f].max(c);
+            }
+        }
+    }
+    for (peer, theirs) in ["lammps", "liggghts"].iter().zip(&peer_laws) {
+        for (f, (name, c)) in chi2s(theirs, &ours, window).into_iter().enumerate() {
+            assert!(
+                c < PEER_MARGIN * spread[f],
+                "{name}: {peer} against verdem chi2/dof {c:.2}, the peer laws' spread {:.2}",
+                spread[f]
+            );
+        }
+        // The yardstick can fail: the same comparison with verdem's vx shifted by 0.05.
+        let mut shifted = ours.clone();
+        for row in &mut shifted.mean {
+            row[cg::FIELDS[0].1] += 0.05;
+        }
+        let (_, c) = chi2s(theirs, &shifted, window)[0];
+        assert!(
+            c > PEER_MARGIN * spread[0],
+            "{peer}: a 0.05 shift of vx gives {c:.2}"
+        );
+    }
+}
+
+/// Allowed χ²/dof of a peer against verdem's own law: this times the peer laws' spread.
+const PEER_MARGIN: f64 = 1.5;
 
 /// Steps of the short run (72 time units) and its saves: the length of the calibration windows.
 const STEPS: u64 = 1_000_000;
