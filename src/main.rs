@@ -132,7 +132,8 @@ enum Command {
         out: PathBuf,
     },
     /// Compare profiles tables (`verdem cg` output, e.g. golden/peers/*.profiles.csv) with a
-    /// reference over the core: χ²/dof and relative difference of the core means of each benchmark profile.
+    /// reference over the core: χ²/dof and relative difference of the core means of each
+    /// benchmark profile.
     Compare {
         /// The reference table.
         reference: PathBuf,

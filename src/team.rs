@@ -7,8 +7,9 @@ use std::cell::UnsafeCell;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-/// How long a thread spins at a barrier before it sleeps: longer than the waits of a balanced
-/// step on an idle machine (a few microseconds), far shorter than a scheduler time slice.
+/// How long a thread spins at a barrier before it sleeps: longer than most waits of a step on
+/// an idle machine (10 µs was not: waking a sleeper costs more than the wait), far shorter than
+/// a scheduler time slice.
 const SPIN: Duration = Duration::from_micros(50);
 
 /// A reusable barrier for a fixed number of threads. Threads spin for up to [`SPIN`], then
@@ -58,7 +59,7 @@ impl SpinBarrier {
         let mut spins = 0u32;
         while self.round.load(Ordering::Acquire) == round {
             spins = spins.wrapping_add(1);
-            if spins % 64 == 0 && start.elapsed() > SPIN {
+            if spins.is_multiple_of(64) && start.elapsed() > SPIN {
                 self.sleep(round);
                 return;
             }
@@ -154,46 +155,42 @@ mod tests {
         );
     }
 
-    #[test]
-    fn barrier_orders_phases_across_threads() {
-        let barrier = SpinBarrier::new(2);
+    /// Runs `threads` threads through `rounds` rounds of two phases; `late(tid, round)` makes a
+    /// thread arrive later than the spin time. Each phase must see every thread's increment.
+    fn run_phases(threads: usize, rounds: usize, late: impl Fn(usize, usize) -> bool + Sync) {
+        let barrier = SpinBarrier::new(threads);
         let counter = AtomicUsize::new(0);
         std::thread::scope(|s| {
-            for _ in 0..2 {
-                s.spawn(|| {
-                    for round in 0..1000 {
-                        counter.fetch_add(1, Ordering::Relaxed);
-                        barrier.wait();
-                        assert_eq!(counter.load(Ordering::Relaxed), 2 * (round + 1));
-                        barrier.wait();
-                    }
-                });
-            }
-        });
-    }
-
-    #[test]
-    fn barrier_orders_phases_when_threads_sleep() {
-        // One thread in three is late by more than the spin time every few rounds, so the
-        // others take the futex path; the phases stay ordered and nobody is left asleep.
-        let barrier = SpinBarrier::new(3);
-        let counter = AtomicUsize::new(0);
-        std::thread::scope(|s| {
-            for tid in 0..3 {
-                let (barrier, counter) = (&barrier, &counter);
+            for tid in 0..threads {
+                let (barrier, counter, late) = (&barrier, &counter, &late);
                 s.spawn(move || {
-                    for round in 0..200 {
-                        if tid == round % 3 && round % 4 == 0 {
+                    for round in 0..rounds {
+                        if late(tid, round) {
                             std::thread::sleep(4 * SPIN);
                         }
                         counter.fetch_add(1, Ordering::Relaxed);
                         barrier.wait();
-                        assert_eq!(counter.load(Ordering::Relaxed), 3 * (round + 1));
+                        assert_eq!(counter.load(Ordering::Relaxed), threads * (round + 1));
                         barrier.wait();
                     }
                 });
             }
         });
-        assert_eq!(barrier.sleepers.load(Ordering::Relaxed), 0);
+        assert_eq!(
+            barrier.sleepers.load(Ordering::Relaxed),
+            0,
+            "a thread left asleep"
+        );
+    }
+
+    #[test]
+    fn barrier_orders_phases_across_threads() {
+        run_phases(2, 1000, |_, _| false);
+    }
+
+    #[test]
+    fn barrier_orders_phases_when_threads_sleep() {
+        // One thread in three is late every fourth round, so the others take the futex path.
+        run_phases(3, 200, |tid, round| tid == round % 3 && round % 4 == 0);
     }
 }
