@@ -8,8 +8,9 @@
 //!     combined standard error (block averages). Block errors of a short series miss the
 //!     flow's slow fluctuations, so even the same physics gives χ²/dof above 1: the "replica"
 //!     row, the reference's physics over the next stretch of time (started from the
-//!     reference's last save), measures that noise floor; a variant is within noise when its
-//!     χ²/dof is comparable to the replica's.
+//!     reference's last save, which holds no tangential springs: the few contacts open at that
+//!     instant restart theirs from zero), measures that noise floor; a variant is within noise
+//!     when its χ²/dof is comparable to the replica's.
 //!
 //! Softer contacts keep the restitution coefficient (γ scaled with √k, so η/ω is unchanged)
 //! and the resolution tc/dt (dt scaled with 1/√k).
