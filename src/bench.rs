@@ -16,15 +16,31 @@ use crate::sim::StageTimes;
 /// One configuration: a code and its number of threads or MPI ranks.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Config {
-    Verdem { threads: usize },
-    Peer { peer: Peer, np: usize },
+    /// `copies` independent verdem runs of `threads` threads each, at the same time in one
+    /// process; their rate is the sum of theirs. Two copies of one thread measure what this
+    /// machine gives two fully independent jobs: the ceiling of any 2-thread speed-up.
+    Verdem {
+        threads: usize,
+        copies: usize,
+    },
+    Peer {
+        peer: Peer,
+        np: usize,
+    },
 }
 
 impl Config {
-    pub fn label(&self) -> (String, usize) {
+    /// The code's name and its processes/threads column.
+    pub fn label(&self) -> (String, String) {
         match self {
-            Config::Verdem { threads } => ("verdem (deterministic)".into(), *threads),
-            Config::Peer { peer, np } => (format!("{peer:?}").to_lowercase(), *np),
+            Config::Verdem { threads, copies: 1 } => {
+                ("verdem (deterministic)".into(), threads.to_string())
+            }
+            Config::Verdem { threads, copies } => (
+                format!("{copies} independent verdem runs at once (summed)"),
+                format!("{copies}×{threads}"),
+            ),
+            Config::Peer { peer, np } => (format!("{peer:?}").to_lowercase(), np.to_string()),
         }
     }
 }
@@ -40,14 +56,17 @@ pub struct Measured {
 impl Measured {
     /// Median steps per second.
     pub fn median(&self) -> f64 {
-        let mut r = self.rates.clone();
-        r.sort_by(f64::total_cmp);
-        let n = r.len();
-        if n % 2 == 1 {
-            r[n / 2]
-        } else {
-            0.5 * (r[n / 2 - 1] + r[n / 2])
-        }
+        median(self.rates.clone())
+    }
+}
+
+fn median(mut r: Vec<f64>) -> f64 {
+    r.sort_by(f64::total_cmp);
+    let n = r.len();
+    if n % 2 == 1 {
+        r[n / 2]
+    } else {
+        0.5 * (r[n / 2 - 1] + r[n / 2])
     }
 }
 
@@ -84,27 +103,33 @@ pub fn run(
     for _ in 0..rounds {
         for m in out.iter_mut() {
             match &m.config {
-                Config::Verdem { threads } => {
-                    let mut e = engine::build(
-                        case,
-                        crate::scene::build(case, Some(state))?,
-                        &Overrides {
-                            threads: Some(*threads),
-                            ..Overrides::default()
-                        },
-                    );
-                    e.advance(0);
-                    e.core_mut().times = StageTimes::default();
+                Config::Verdem { threads, copies } => {
+                    let mut engines = (0..*copies)
+                        .map(|_| {
+                            let mut e = engine::build(
+                                case,
+                                crate::scene::build(case, Some(state))?,
+                                &Overrides {
+                                    threads: Some(*threads),
+                                    ..Overrides::default()
+                                },
+                            );
+                            e.advance(0);
+                            e.core_mut().times = StageTimes::default();
+                            Ok(e)
+                        })
+                        .collect::<anyhow::Result<Vec<_>>>()?;
                     let t0 = Instant::now();
-                    // chunks as in a run (progress and saves happen between them)
-                    let mut left = steps;
-                    while left > 0 {
-                        let k = left.min(2000);
-                        e.advance(k);
-                        left -= k;
-                    }
-                    m.rates.push(steps as f64 / t0.elapsed().as_secs_f64());
-                    m.stages = Some(e.core().times);
+                    std::thread::scope(|s| {
+                        let (first, rest) = engines.split_at_mut(1);
+                        for e in rest {
+                            s.spawn(move || advance_in_chunks(e.as_mut(), steps));
+                        }
+                        advance_in_chunks(first[0].as_mut(), steps);
+                    });
+                    m.rates
+                        .push((*copies as u64 * steps) as f64 / t0.elapsed().as_secs_f64());
+                    m.stages = Some(engines[0].core().times);
                 }
                 Config::Peer { peer, np } => {
                     let dir = work.join(format!("{}-{np}", peer.binary()));
@@ -125,12 +150,28 @@ pub fn run(
     Ok(out)
 }
 
+/// Advances `steps` steps in chunks as a run does (progress and saves happen between them).
+fn advance_in_chunks(e: &mut dyn crate::sim::Engine, steps: u64) {
+    let mut left = steps;
+    while left > 0 {
+        let k = left.min(2000);
+        e.advance(k);
+        left -= k;
+    }
+}
+
+/// The median over the rounds of the rate of `b` over that of `a` in the same round (paired:
+/// the runs of one round are seconds apart, so a drift of the machine cancels).
+pub fn paired_ratio(a: &Measured, b: &Measured) -> f64 {
+    median(a.rates.iter().zip(&b.rates).map(|(x, y)| y / x).collect())
+}
+
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
 /// particle-steps/s, and verdem's best rate over the code's.
 pub fn markdown(m: &[Measured], particles: usize) -> String {
     let best = m
         .iter()
-        .filter(|x| matches!(x.config, Config::Verdem { .. }))
+        .filter(|x| matches!(x.config, Config::Verdem { copies: 1, .. }))
         .map(Measured::median)
         .fold(0.0, f64::max);
     let mut s = String::from("| code | procs/threads | steps/s (median) | rounds | particle-steps/s | verdem best / this |\n|---|---|---|---|---|---|\n");
@@ -145,8 +186,26 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             best / x.median()
         ));
     }
+    let find = |threads: usize, copies: usize| {
+        m.iter()
+            .find(|x| x.config == Config::Verdem { threads, copies })
+    };
+    if let (Some(one), Some(two)) = (find(1, 1), find(2, 1)) {
+        s.push_str(&format!(
+            "\nverdem 2 threads / 1 thread: {:.2} (median over the rounds of the ratio within a round)",
+            paired_ratio(one, two)
+        ));
+        if let Some(pair) = find(1, 2) {
+            let ceiling = paired_ratio(one, pair);
+            s.push_str(&format!(
+                "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
+                100.0 * paired_ratio(one, two) / ceiling
+            ));
+        }
+        s.push('\n');
+    }
     for x in m {
-        if let (Config::Verdem { threads }, Some(st)) = (&x.config, &x.stages) {
+        if let (Config::Verdem { threads, copies: 1 }, Some(st)) = (&x.config, &x.stages) {
             let total = (st.neighbor + st.forces + st.integrate + st.wait).max(1) as f64;
             let pct = |v: u64| 100.0 * v as f64 / total;
             s.push_str(&format!(

@@ -111,6 +111,10 @@ enum Command {
         /// Alternating rounds.
         #[arg(long, default_value_t = 3)]
         rounds: usize,
+        /// Skip the ceiling row: two independent 1-thread verdem runs at once, which measures
+        /// what this machine gives two jobs that share nothing.
+        #[arg(long)]
+        no_ceiling: bool,
         /// Where the table (bench.md, bench.csv) and the peers' inputs go.
         #[arg(long, default_value = "out/bench")]
         out: PathBuf,
@@ -379,14 +383,24 @@ fn real_main() -> anyhow::Result<()> {
             peers,
             np,
             rounds,
+            no_ceiling,
             out,
         } => {
             let case =
                 Case::load(&case.unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml")))?;
             let mut configs: Vec<bench::Config> = threads
                 .iter()
-                .map(|&t| bench::Config::Verdem { threads: t })
+                .map(|&t| bench::Config::Verdem {
+                    threads: t,
+                    copies: 1,
+                })
                 .collect();
+            if !no_ceiling {
+                configs.push(bench::Config::Verdem {
+                    threads: 1,
+                    copies: 2,
+                });
+            }
             for name in peers.iter().filter(|p| !p.is_empty()) {
                 let peer = match name.as_str() {
                     "lammps" => verdem::peers::Peer::Lammps,

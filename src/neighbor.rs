@@ -47,6 +47,14 @@ pub struct NeighborBuilder {
     pub search: Search,
     keys: Vec<(u32, u32)>,
     cell_start: Vec<u32>,
+    /// Half stencils of the grid they were made for, as runs of consecutive cells: the cells
+    /// `stencil[j].0..stencil[j].1` for `j` in `stencil_start[c]..stencil_start[c + 1]` are
+    /// the distinct cells adjacent to (or equal to) cell `c`, less the runs that lie wholly
+    /// below `c`, in increasing order. The grid depends on the box alone, so they are made
+    /// once.
+    stencil: Vec<(u32, u32)>,
+    stencil_start: Vec<u32>,
+    stencil_grid: Option<([usize; 3], [usize; 3], [bool; 3])>,
 }
 
 impl NeighborBuilder {
@@ -59,6 +67,9 @@ impl NeighborBuilder {
             search,
             keys: Vec::new(),
             cell_start: Vec::new(),
+            stencil: Vec::new(),
+            stencil_start: Vec::new(),
+            stencil_grid: None,
         }
     }
 
@@ -79,7 +90,8 @@ impl NeighborBuilder {
     /// Rebuilds the pairs of `list` for particles already in [`NeighborBuilder::order`]'s
     /// order, grouped by owner; the per-particle lists are made by [`PairList::index`] once the
     /// caller has settled the pairs' order. A pair enters when |x_P − x_I| < r_P + r_I + skin and
-    /// `interacts(a, b)` (wall–wall pairs never do).
+    /// `interacts(a, b)` (wall–wall pairs never do). The same as [`NeighborBuilder::prepare`]
+    /// and one [`NeighborBuilder::search`] over all owners.
     pub fn build(
         &mut self,
         list: &mut PairList,
@@ -89,74 +101,127 @@ impl NeighborBuilder {
         id: &[u32],
         interacts: impl Fn(usize, usize) -> bool,
     ) {
-        let n = x.len();
+        self.prepare(domain, x);
         list.p.clear();
         list.i.clear();
+        let found = (&mut list.p, &mut list.i);
+        self.search(domain, x, radius, id, 0..x.len(), interacts, found);
+    }
+
+    /// Locates the particles `x` (in [`NeighborBuilder::order`]'s order) in the cells, for the
+    /// searches that follow.
+    pub fn prepare(&mut self, domain: &Domain, x: &[Vec3]) {
+        if self.search == Search::AllPairs {
+            return;
+        }
+        let grid = Grid::new(domain, self.cell);
+        // Particles are sorted by cell: each cell is a contiguous range.
+        self.cell_start.clear();
+        self.cell_start.resize(grid.count() + 1, 0);
+        for p in x {
+            self.cell_start[grid.index(grid.coords(domain, p)) + 1] += 1;
+        }
+        for c in 0..grid.count() {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.make_stencils(&grid);
+    }
+
+    /// Appends to `found` (P, I memory indices) the pairs owned by the particles `owners`, the
+    /// owner of a pair being its particle of lower memory index, in the order of owners and then
+    /// of partners; the searches of consecutive owner ranges, concatenated, give one search of
+    /// their union. Needs [`NeighborBuilder::prepare`] for the same `x`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn search(
+        &self,
+        domain: &Domain,
+        x: &[Vec3],
+        radius: &[f64],
+        id: &[u32],
+        owners: std::ops::Range<usize>,
+        interacts: impl Fn(usize, usize) -> bool,
+        found: (&mut Vec<u32>, &mut Vec<u32>),
+    ) {
+        let (found_p, found_i) = found;
         let skin = self.skin;
-        let accept = |a: usize, b: usize| {
+        let mut consider = |a: usize, b: usize| {
             let cut = radius[a] + radius[b] + skin;
-            interacts(a, b) && domain.min_image(x[a] - x[b]).norm_squared() < cut * cut
-        };
-        let push = |list: &mut PairList, a: usize, b: usize| {
-            if id[a] < id[b] {
-                list.p.push(a as u32);
-                list.i.push(b as u32);
-            } else {
-                list.p.push(b as u32);
-                list.i.push(a as u32);
+            if interacts(a, b) && domain.min_image(x[a] - x[b]).norm_squared() < cut * cut {
+                let (p, i) = if id[a] < id[b] { (a, b) } else { (b, a) };
+                found_p.push(p as u32);
+                found_i.push(i as u32);
             }
         };
         match self.search {
             Search::AllPairs => {
-                for a in 0..n {
-                    for b in a + 1..n {
-                        if accept(a, b) {
-                            push(list, a, b);
-                        }
+                for a in owners {
+                    for b in a + 1..x.len() {
+                        consider(a, b);
                     }
                 }
             }
             Search::Cells => {
-                let grid = Grid::new(domain, self.cell);
-                // Particles are sorted by cell: each cell is a contiguous range.
-                self.cell_start.clear();
-                self.cell_start.resize(grid.count() + 1, 0);
-                for p in x {
-                    self.cell_start[grid.index(grid.coords(domain, p)) + 1] += 1;
-                }
-                for c in 0..grid.count() {
-                    self.cell_start[c + 1] += self.cell_start[c];
-                }
-                let mut near = [0usize; 27];
-                for c in 0..grid.count() {
+                let cells = self.cell_start.len() - 1;
+                let first = self
+                    .cell_start
+                    .partition_point(|&s| s as usize <= owners.start);
+                for c in first.saturating_sub(1)..cells {
                     let (s, e) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
-                    if s == e {
-                        continue;
+                    if s >= owners.end {
+                        break;
                     }
-                    let mut count = 0;
-                    grid.for_each_neighbour(grid.cell_coords(c), |nc| {
-                        near[count] = nc;
-                        count += 1;
-                    });
+                    let near = &self.stencil
+                        [self.stencil_start[c] as usize..self.stencil_start[c + 1] as usize];
                     // Cells in index order hold increasing memory indices: each particle's
-                    // partners come out sorted.
-                    near[..count].sort_unstable();
-                    for a in s..e {
-                        for &nc in &near[..count] {
+                    // partners come out sorted (and those in cells below c are lower).
+                    for a in s.max(owners.start)..e.min(owners.end) {
+                        for &(lo, hi) in near {
                             let (s, e) = (
-                                self.cell_start[nc] as usize,
-                                self.cell_start[nc + 1] as usize,
+                                self.cell_start[lo as usize] as usize,
+                                self.cell_start[hi as usize] as usize,
                             );
                             for b in s.max(a + 1)..e {
-                                if accept(a, b) {
-                                    push(list, a, b);
-                                }
+                                consider(a, b);
                             }
                         }
                     }
                 }
             }
         }
+    }
+
+    /// Makes the half stencils of `grid` unless they are those of the last build.
+    fn make_stencils(&mut self, grid: &Grid) {
+        if self.stencil_grid == Some((grid.n, grid.axes, grid.periodic)) {
+            return;
+        }
+        self.stencil.clear();
+        self.stencil_start.clear();
+        self.stencil_start.push(0);
+        let mut near = Vec::with_capacity(27);
+        for c in 0..grid.count() {
+            near.clear();
+            grid.for_each_neighbour(grid.cell_coords(c), |nc| near.push(nc as u32));
+            near.sort_unstable();
+            // Cells adjacent along the fastest axis have consecutive indices: one run each.
+            let start = self.stencil.len();
+            for &nc in &near {
+                match self.stencil[start..].last_mut() {
+                    Some(run) if run.1 == nc => run.1 = nc + 1,
+                    _ => self.stencil.push((nc, nc + 1)),
+                }
+            }
+            let mut kept = start;
+            for j in start..self.stencil.len() {
+                if self.stencil[j].1 as usize > c {
+                    self.stencil[kept] = self.stencil[j];
+                    kept += 1;
+                }
+            }
+            self.stencil.truncate(kept);
+            self.stencil_start.push(self.stencil.len() as u32);
+        }
+        self.stencil_grid = Some((grid.n, grid.axes, grid.periodic));
     }
 }
 
@@ -351,6 +416,47 @@ mod tests {
         assert!(!cells.p.is_empty());
         assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
         assert!((0..cells.p.len()).all(|k| ids[cells.p[k] as usize] < ids[cells.i[k] as usize]));
+    }
+
+    proptest::proptest! {
+        /// Boxes of one to five cells a side, any axis periodic or walled: the runs of the half
+        /// stencils (including those that wrap, and grids too small for 27 distinct cells) miss
+        /// no pair and list none twice, and a search split between owner ranges finds the same
+        /// pairs in the same order.
+        #[test]
+        fn cell_search_equals_all_pairs_on_any_grid(
+            lengths in proptest::array::uniform3(1.0f64..7.0),
+            periodic in proptest::array::uniform3(proptest::bool::ANY),
+            n in 1usize..120,
+            seed in 0u64..1000,
+            split in 0.0f64..1.0,
+        ) {
+            let domain = Domain::new(Vec3::zeros(), Vec3::from(lengths), periodic);
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let x: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::from(std::array::from_fn(|k| rng.gen_range(0.0..lengths[k]))))
+                .collect();
+            let r = vec![0.3; n];
+            let id: Vec<u32> = (0..n as u32).collect();
+            let mut b = NeighborBuilder::new(0.1, 0.0, 0.3, Search::Cells);
+            let mut order = Vec::new();
+            b.order(&domain, &x, &id, &mut order);
+            let xs: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
+            let ids: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
+            let mut cells = PairList::default();
+            b.build(&mut cells, &domain, &xs, &r, &ids, |_, _| true);
+            let mut all = PairList::default();
+            NeighborBuilder::new(0.1, 0.0, 0.3, Search::AllPairs)
+                .build(&mut all, &domain, &x, &r, &id, |_, _| true);
+            proptest::prop_assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
+            // two searches over consecutive owner ranges, concatenated, are the one search
+            let m = (split * n as f64) as usize;
+            let (mut p, mut i) = (Vec::new(), Vec::new());
+            for owners in [0..m, m..n] {
+                b.search(&domain, &xs, &r, &ids, owners, |_, _| true, (&mut p, &mut i));
+            }
+            proptest::prop_assert_eq!((p, i), (cells.p, cells.i));
+        }
     }
 
     #[test]

@@ -119,10 +119,14 @@ pub struct Core {
 #[derive(Default)]
 struct Scratch {
     order: Vec<u32>,
-    vec3: Vec<Vec3>,
-    real: Vec<f64>,
-    motion: Vec<Motion>,
-    index: Vec<u32>,
+    /// The particles and ids in the new memory order, filled by the team and then swapped in.
+    next: Particles,
+    next_id: Vec<u32>,
+    /// The pairs each part of a build's search found, concatenated into the pair list.
+    found: Vec<(Vec<u32>, Vec<u32>)>,
+    /// P and I of the pairs in their final order, filled by the team and then swapped in.
+    next_p: Vec<u32>,
+    next_i: Vec<u32>,
     old_keys: Vec<(u64, u32)>,
     old_xi: Vec<Vec3>,
     fill: Vec<u32>,
@@ -200,6 +204,7 @@ impl Core {
             builder,
             scratch: Scratch {
                 particle_ranges: vec![(0, 0); threads],
+                found: vec![(Vec::new(), Vec::new()); threads],
                 speed: [vec![1.0; threads], vec![1.0; threads]],
                 ..Scratch::default()
             },
@@ -233,7 +238,7 @@ impl Core {
     pub fn rebuild(&mut self) {
         let domain = self.domain.clone();
         self.list_state()
-            .rebuild(&domain, &[Vec::new(), Vec::new()]);
+            .rebuild(Crew::Solo, &domain, &[Vec::new(), Vec::new()]);
         self.moved_bound = [0.0; 2];
     }
 
@@ -475,9 +480,11 @@ impl<L: ContactLaw> Simulation<L> {
                     }
                     busy_local = [0; 2];
                     barrier.wait();
-                    if tid == 0 {
-                        unsafe { list.get().rebuild(view.domain, &busy) };
-                    }
+                    let crew = Crew::Member {
+                        tid,
+                        barrier: &barrier,
+                    };
+                    unsafe { list.get().rebuild(crew, view.domain, &busy) };
                     barrier.wait();
                     lap(&mut local.neighbor);
                 }
@@ -557,50 +564,162 @@ struct ListState<'a> {
     kind: &'a mut Vec<u8>,
 }
 
-fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
-    scratch.clear();
-    scratch.extend(order.iter().map(|&o| v[o as usize]));
-    std::mem::swap(v, scratch);
+/// Who runs a rebuild: the team, each thread between the same barriers, or one thread alone
+/// (outside a run), which then does every thread's part itself.
+#[derive(Clone, Copy)]
+enum Crew<'b> {
+    Solo,
+    Member {
+        tid: usize,
+        barrier: &'b SpinBarrier,
+    },
+}
+
+impl Crew<'_> {
+    /// The parts of each parallel phase this thread does, of `parts`.
+    fn parts(self, parts: usize) -> std::ops::Range<usize> {
+        match self {
+            Crew::Solo => 0..parts,
+            Crew::Member { tid, .. } => tid..tid + 1,
+        }
+    }
+
+    /// Whether this thread does the serial phases.
+    fn leads(self) -> bool {
+        matches!(self, Crew::Solo | Crew::Member { tid: 0, .. })
+    }
+
+    /// Waits for the whole crew.
+    fn sync(self) {
+        if let Crew::Member { barrier, .. } = self {
+            barrier.wait();
+        }
+    }
+}
+
+/// Part `part` of `0..n` split into `parts` nearly equal contiguous ranges.
+fn chunk(n: usize, parts: usize, part: usize) -> (usize, usize) {
+    (n * part / parts, n * (part + 1) / parts)
+}
+
+/// `to[k] = from[order[k]]` for `k` in `a..b`.
+fn permute_range<T: Copy>(from: &[T], to: &mut [T], order: &[u32], a: usize, b: usize) {
+    for (t, &o) in to[a..b].iter_mut().zip(&order[a..b]) {
+        *t = from[o as usize];
+    }
 }
 
 impl ListState<'_> {
     /// Re-orders the particles by cell, rebuilds the pair list, carries every contact's history
     /// over (matched by original ids), and re-balances the threads' ranges; `busy` holds each
     /// thread's compute time (ns) in the particle [0] and the pair [1] pass since the last build,
-    /// when known.
-    fn rebuild(&mut self, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
+    /// when known. The serial phases run on the lead thread, the others (permutation, search,
+    /// sorting of the shares, history) in parts, one a thread; the results do not depend on the
+    /// crew.
+    ///
+    /// # Safety (team)
+    /// Every thread of the crew calls this with the same arguments; in a parallel phase each
+    /// writes only its part's ranges, and no vector is resized outside the lead's phases.
+    fn rebuild(&mut self, crew: Crew<'_>, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
         let t0 = Instant::now();
         let s = &mut *self.scratch;
-        // History of the contacts, by original ids.
-        s.old_keys.clear();
-        for k in 0..self.pairs.p.len() {
-            if self.active[k] {
-                let (p, i) = (
-                    self.id[self.pairs.p[k] as usize],
-                    self.id[self.pairs.i[k] as usize],
-                );
-                s.old_keys.push((key(p, i), k as u32));
-            }
-        }
-        s.old_keys.sort_unstable();
-        std::mem::swap(&mut s.old_xi, self.xi);
-        // Memory order by cell.
         let pt = &mut *self.particles;
-        self.builder.order(domain, &pt.x, self.id, &mut s.order);
-        for v in [&mut pt.x, &mut pt.v, &mut pt.w, &mut pt.f, &mut pt.t] {
-            permute(v, &s.order, &mut s.vec3);
+        let threads = s.particle_ranges.len();
+        let n = pt.len();
+        if crew.leads() {
+            // History of the contacts, by original ids.
+            s.old_keys.clear();
+            for k in 0..self.pairs.p.len() {
+                if self.active[k] {
+                    let (p, i) = (
+                        self.id[self.pairs.p[k] as usize],
+                        self.id[self.pairs.i[k] as usize],
+                    );
+                    s.old_keys.push((key(p, i), k as u32));
+                }
+            }
+            s.old_keys.sort_unstable();
+            std::mem::swap(&mut s.old_xi, self.xi);
+            // Memory order by cell.
+            self.builder.order(domain, &pt.x, self.id, &mut s.order);
+            if s.next.len() != n {
+                // room only: every element is written below
+                s.next = pt.clone();
+            }
+            s.next_id.resize(n, 0);
         }
-        for v in [&mut pt.radius, &mut pt.inv_mass, &mut pt.inv_inertia] {
-            permute(v, &s.order, &mut s.real);
+        crew.sync();
+        for part in crew.parts(threads) {
+            let (a, b) = chunk(n, threads, part);
+            let (from, to, o) = (&*pt, &mut s.next, &s.order);
+            permute_range(&from.x, &mut to.x, o, a, b);
+            permute_range(&from.v, &mut to.v, o, a, b);
+            permute_range(&from.w, &mut to.w, o, a, b);
+            permute_range(&from.f, &mut to.f, o, a, b);
+            permute_range(&from.t, &mut to.t, o, a, b);
+            permute_range(&from.radius, &mut to.radius, o, a, b);
+            permute_range(&from.inv_mass, &mut to.inv_mass, o, a, b);
+            permute_range(&from.inv_inertia, &mut to.inv_inertia, o, a, b);
+            permute_range(&from.motion, &mut to.motion, o, a, b);
+            permute_range(self.id, &mut s.next_id, o, a, b);
         }
-        permute(&mut pt.motion, &s.order, &mut s.motion);
-        permute(self.id, &s.order, &mut s.index);
-        let motion = &pt.motion;
-        // Wall–wall pairs never interact (neighbouring wall spheres overlap by round-off).
-        self.builder
-            .build(self.pairs, domain, &pt.x, &pt.radius, self.id, |a, b| {
-                motion[a] == Motion::Free || motion[b] == Motion::Free
-            });
+        crew.sync();
+        if crew.leads() {
+            std::mem::swap(pt, &mut s.next);
+            std::mem::swap(self.id, &mut s.next_id);
+            self.builder.prepare(domain, &pt.x);
+        }
+        crew.sync();
+        for part in crew.parts(threads) {
+            let motion = &pt.motion;
+            let (found_p, found_i) = &mut s.found[part];
+            found_p.clear();
+            found_i.clear();
+            // Wall–wall pairs never interact (neighbouring wall spheres overlap by round-off).
+            self.builder.search(
+                domain,
+                &pt.x,
+                &pt.radius,
+                self.id,
+                {
+                    let (a, b) = chunk(n, threads, part);
+                    a..b
+                },
+                |a, b| motion[a] == Motion::Free || motion[b] == Motion::Free,
+                (found_p, found_i),
+            );
+        }
+        crew.sync();
+        if crew.leads() {
+            self.pairs.p.clear();
+            self.pairs.i.clear();
+            for (found_p, found_i) in &s.found {
+                self.pairs.p.extend_from_slice(found_p);
+                self.pairs.i.extend_from_slice(found_i);
+            }
+            self.plan_shares(domain, busy);
+        }
+        crew.sync();
+        for part in crew.parts(threads) {
+            self.sort_share(domain, part);
+        }
+        crew.sync();
+        if crew.leads() {
+            let s = &mut *self.scratch;
+            std::mem::swap(&mut self.pairs.p, &mut s.next_p);
+            std::mem::swap(&mut self.pairs.i, &mut s.next_i);
+            self.pairs.index(n, self.id, &mut s.fill);
+            self.times.neighbor += t0.elapsed().as_nanos() as u64;
+            self.times.rebuilds += 1;
+        }
+    }
+
+    /// Lead phase of a rebuild, once the pairs are found: the particles' flags and speed
+    /// classes, the threads' shares of both passes, and room for the pairs' new order and
+    /// history.
+    fn plan_shares(&mut self, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
+        let s = &mut *self.scratch;
+        let pt = &*self.particles;
         let n_pairs = self.pairs.p.len();
         // All clear between a particle pass and a pair pass; only the length can change.
         self.touched
@@ -647,13 +766,7 @@ impl ListState<'_> {
         );
         pair_weight.clear();
         pair_weight.extend(s.pair_bounds.iter().map(|&(a, b)| 2 * (b - a) as u64));
-        // Within a share, interior pairs (no periodic image needed until the next build) come
-        // first, then the others; each part in bins of gap (GAP_BINS − 1 bins of a sixteenth of
-        // the skin, after one of all overlapping pairs), each bin in build (owner memory) order.
-        // A step visits only the prefix of bins whose gap the particles can have closed (see
-        // `live`), in near-memory order.
         let skin = self.builder.skin;
-        let bin_width = skin / 16.0;
         let interior = |a: usize| {
             (0..3).all(|k| {
                 !domain.periodic[k]
@@ -662,8 +775,32 @@ impl ListState<'_> {
         };
         self.near_face.clear();
         self.near_face.extend((0..pt.len()).map(|a| !interior(a)));
-        s.bin.clear();
-        for k in 0..n_pairs {
+        s.bin.resize(n_pairs, 0);
+        s.sorted.resize(n_pairs, 0);
+        s.gap.resize(n_pairs, 0.0);
+        s.next_p.resize(n_pairs, 0);
+        s.next_i.resize(n_pairs, 0);
+        s.pair_ranges.resize(threads, [0; CLASSES + 1]);
+        self.xi.clear();
+        self.xi.resize(n_pairs, Vec3::zeros());
+        self.active.clear();
+        self.active.resize(n_pairs, false);
+        self.out.resize(n_pairs, PairForce::default());
+    }
+
+    /// Parallel phase of a rebuild: share `part` of the pairs in its final order and with its
+    /// history. Within a share, interior pairs (no periodic image needed until the next build)
+    /// come first, then the others; each part in bins of gap (GAP_BINS − 1 bins of a sixteenth
+    /// of the skin, after one of all overlapping pairs), each bin in build (owner memory) order.
+    /// A step visits only the prefix of bins whose gap the particles can have closed (see
+    /// `live`), in near-memory order.
+    fn sort_share(&mut self, domain: &Domain, part: usize) {
+        let s = &mut *self.scratch;
+        let pt = &*self.particles;
+        let (pa, pb) = s.pair_bounds[part];
+        let skin = self.builder.skin;
+        let bin_width = skin / 16.0;
+        for k in pa..pb {
             let (p, i) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
             let direct = pt.x[p] - pt.x[i];
             let r = domain.min_image(direct);
@@ -680,71 +817,54 @@ impl ListState<'_> {
             };
             let class =
                 3 * usize::from(!plain) + usize::from(self.kind[p]) + usize::from(self.kind[i]);
-            s.bin.push((class * GAP_BINS + bin) as u8);
+            s.bin[k] = (class * GAP_BINS + bin) as u8;
         }
-        // A stable counting sort of each share by (class, bin).
-        s.sorted.clear();
-        s.sorted.resize(n_pairs, 0);
-        s.gap.clear();
-        s.gap.resize(n_pairs, 0.0);
-        s.pair_ranges.clear();
-        for &(pa, pb) in &s.pair_bounds {
-            let mut next = [0usize; CLASSES * GAP_BINS];
-            for &b in &s.bin[pa..pb] {
-                next[b as usize] += 1;
-            }
-            let mut at = pa;
-            for (b, n) in next.iter_mut().enumerate() {
-                let count = *n;
-                *n = at;
-                // Lower edge of the bin; overlapping pairs (bin 0) are always visited.
-                s.gap[at..at + count].fill((b % GAP_BINS) as f64 * bin_width - bin_width);
-                at += count;
-            }
-            let mut ranges = [pb; CLASSES + 1];
-            for (c, r) in ranges.iter_mut().take(CLASSES).enumerate() {
-                *r = next[c * GAP_BINS];
-            }
-            s.pair_ranges.push(ranges);
-            for k in pa..pb {
-                let slot = &mut next[s.bin[k] as usize];
-                s.sorted[*slot] = k as u32;
-                *slot += 1;
-            }
+        // A stable counting sort of the share by (class, bin).
+        let mut next = [0usize; CLASSES * GAP_BINS];
+        for &b in &s.bin[pa..pb] {
+            next[b as usize] += 1;
         }
-        for list in [&mut self.pairs.p, &mut self.pairs.i] {
-            s.index.clear();
-            s.index.extend(s.sorted.iter().map(|&k| list[k as usize]));
-            std::mem::swap(list, &mut s.index);
+        let mut at = pa;
+        for (b, n) in next.iter_mut().enumerate() {
+            let count = *n;
+            *n = at;
+            // Lower edge of the bin; overlapping pairs (bin 0) are always visited.
+            s.gap[at..at + count].fill((b % GAP_BINS) as f64 * bin_width - bin_width);
+            at += count;
         }
-        self.pairs.index(pt.len(), self.id, &mut s.fill);
-        self.xi.clear();
-        self.xi.resize(n_pairs, Vec3::zeros());
-        self.active.clear();
-        self.active.resize(n_pairs, false);
-        self.out.resize(n_pairs, PairForce::default());
-        if !s.old_keys.is_empty() {
-            for k in 0..n_pairs {
-                let (p, i) = (
-                    self.id[self.pairs.p[k] as usize],
-                    self.id[self.pairs.i[k] as usize],
-                );
-                // A contact the particles have just left would be closed by the coming force
-                // pass; close it here, since that pass may skip pairs with a positive gap.
-                let (pm, im) = (self.pairs.p[k] as usize, self.pairs.i[k] as usize);
-                let sum = pt.radius[pm] + pt.radius[im];
-                let touching = domain.min_image(pt.x[pm] - pt.x[im]).norm_squared() < sum * sum;
-                if !touching {
-                    continue;
-                }
-                if let Ok(o) = s.old_keys.binary_search_by_key(&key(p, i), |e| e.0) {
-                    self.xi[k] = s.old_xi[s.old_keys[o].1 as usize];
-                    self.active[k] = true;
-                }
+        let mut ranges = [pb; CLASSES + 1];
+        for (c, r) in ranges.iter_mut().take(CLASSES).enumerate() {
+            *r = next[c * GAP_BINS];
+        }
+        s.pair_ranges[part] = ranges;
+        for k in pa..pb {
+            let slot = &mut next[s.bin[k] as usize];
+            s.sorted[*slot] = k as u32;
+            *slot += 1;
+        }
+        for k in pa..pb {
+            let from = s.sorted[k] as usize;
+            s.next_p[k] = self.pairs.p[from];
+            s.next_i[k] = self.pairs.i[from];
+        }
+        if s.old_keys.is_empty() {
+            return;
+        }
+        for k in pa..pb {
+            let (pm, im) = (s.next_p[k] as usize, s.next_i[k] as usize);
+            // A contact the particles have just left would be closed by the coming force
+            // pass; close it here, since that pass may skip pairs with a positive gap.
+            let sum = pt.radius[pm] + pt.radius[im];
+            let touching = domain.min_image(pt.x[pm] - pt.x[im]).norm_squared() < sum * sum;
+            if !touching {
+                continue;
+            }
+            let (p, i) = (self.id[pm], self.id[im]);
+            if let Ok(o) = s.old_keys.binary_search_by_key(&key(p, i), |e| e.0) {
+                self.xi[k] = s.old_xi[s.old_keys[o].1 as usize];
+                self.active[k] = true;
             }
         }
-        self.times.neighbor += t0.elapsed().as_nanos() as u64;
-        self.times.rebuilds += 1;
     }
 }
 

@@ -65,7 +65,7 @@ fn cell_list_gives_the_same_trajectory_as_all_pairs() {
     assert_eq!(a, b);
 }
 
-/// Deterministic mode: the same bits for 1 and 2 threads, any skin and any cell size, over
+/// Deterministic mode: the same bits for 1, 2 and 3 threads, any skin and any cell size, over
 /// 20000 steps of the developed, contact-rich state.
 #[test]
 fn threads_skin_and_cell_size_do_not_change_a_bit() {
@@ -85,6 +85,8 @@ fn threads_skin_and_cell_size_do_not_change_a_bit() {
     };
     let reference = run(1, 0.1, 0.0);
     assert_eq!(run(2, 0.1, 0.0), reference, "2 threads");
+    // three parts of every parallel phase, on two cores
+    assert_eq!(run(3, 0.1, 0.0), reference, "3 threads");
     assert_eq!(run(2, 0.35, 0.0), reference, "skin 0.35");
     assert_eq!(run(2, 0.05, 2.7), reference, "skin 0.05, cell 2.7");
 }
