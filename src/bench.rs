@@ -236,3 +236,44 @@ pub fn csv(m: &[Measured], particles: usize) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn measured(threads: usize, copies: usize, rates: &[f64]) -> Measured {
+        Measured {
+            config: Config::Verdem { threads, copies },
+            rates: rates.to_vec(),
+            stages: None,
+        }
+    }
+
+    #[test]
+    fn the_paired_ratio_is_the_median_of_the_ratios_within_rounds() {
+        // ratios 3, 1, 0.5: median 1; the ratio of the medians would be 3/2
+        let (a, b) = (
+            measured(1, 1, &[1.0, 2.0, 10.0]),
+            measured(2, 1, &[3.0, 2.0, 5.0]),
+        );
+        assert_eq!(paired_ratio(&a, &b), 1.0);
+        assert_eq!(b.median() / a.median(), 1.5);
+    }
+
+    #[test]
+    fn the_table_puts_the_two_thread_ratio_against_the_ceiling() {
+        let m = [
+            measured(1, 1, &[100.0, 110.0, 90.0]),
+            measured(2, 1, &[150.0, 143.0, 126.0]),
+            measured(1, 2, &[190.0, 198.0, 180.0]),
+        ];
+        let md = markdown(&m, 10);
+        // 2/1 ratios 1.5, 1.3, 1.4; ceiling ratios 1.9, 1.8, 2.0
+        assert!(md.contains("verdem 2 threads / 1 thread: 1.40"), "{md}");
+        assert!(md.contains("at once / 1 run alone: 1.90"), "{md}");
+        assert!(md.contains("reach 74 % of that"), "{md}");
+        assert!(md.contains("| 2 independent verdem runs at once (summed) | 2×1 | 190 |"));
+        // the ceiling row is not a verdem configuration: "verdem best" is the 2-thread rate
+        assert!(md.contains("| verdem (deterministic) | 1 | 100 | 100, 110, 90 | 1.000e3 | 1.43 |"));
+    }
+}
