@@ -1,6 +1,7 @@
 //! Criterion benchmarks: the pair-force kernel (with MercuryDPM's friction, and the frictionless
 //! law a `mu = 0` case runs), the pair-list rebuild, one full time step of
-//! MercuryDPM's developed shear state (1 and 2 threads), and the coarse-graining of one save.
+//! MercuryDPM's developed shear state (1 and 2 threads), the team's barrier (the fixed cost of
+//! synchronising two threads, paid twice a step), and the coarse-graining of one save.
 //! Needs `../shared/data` beside the repository. Run: `cargo bench`.
 
 use std::hint::black_box;
@@ -96,6 +97,22 @@ fn step(c: &mut Criterion) {
     }
 }
 
+fn barrier(c: &mut Criterion) {
+    c.bench_function("barrier, 2 threads (one round)", |b| {
+        b.iter_custom(|rounds| {
+            let barrier = verdem::team::SpinBarrier::new(2);
+            std::thread::scope(|s| {
+                s.spawn(|| (0..rounds).for_each(|_| barrier.wait()));
+                // both threads are in the loop before the clock starts
+                barrier.wait();
+                let t0 = std::time::Instant::now();
+                (1..rounds).for_each(|_| barrier.wait());
+                t0.elapsed()
+            })
+        })
+    });
+}
+
 fn coarse_grain(c: &mut Criterion) {
     let (_, e) = developed(1);
     let snap = e.core().snapshot();
@@ -129,6 +146,6 @@ criterion_group! {
     name = benches;
     // no HTML plots: they would need a font registered with plotters
     config = Criterion::default().without_plots();
-    targets = pair_kernel, rebuild, step, coarse_grain
+    targets = pair_kernel, rebuild, step, barrier, coarse_grain
 }
 criterion_main!(benches);
