@@ -394,25 +394,48 @@ mod tests {
         v
     }
 
-    #[test]
-    fn cell_search_finds_exactly_the_all_pairs_list_with_pairs_oriented_by_id() {
-        let (domain, x, r, id) = random_scene(300, 7);
-        let mut b = NeighborBuilder::new(0.3, 0.0, 0.5, Search::Cells);
+    /// The cell search on `x` in cell order, and the all-pairs search on `x` as given: the
+    /// builder, the ordered positions and ids, and both lists.
+    struct Searched {
+        builder: NeighborBuilder,
+        xs: Vec<Vec3>,
+        ids: Vec<u32>,
+        cells: PairList,
+        all: PairList,
+    }
+
+    fn search_both(domain: &Domain, x: &[Vec3], r: &[f64], id: &[u32], skin: f64) -> Searched {
+        let mut builder = NeighborBuilder::new(skin, 0.0, r[0], Search::Cells);
         let mut order = Vec::new();
-        b.order(&domain, &x, &id, &mut order);
+        builder.order(domain, x, id, &mut order);
         let xs: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
         let ids: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
         let mut cells = PairList::default();
-        b.build(&mut cells, &domain, &xs, &r, &ids, |_, _| true);
+        builder.build(&mut cells, domain, &xs, r, &ids, |_, _| true);
         let mut all = PairList::default();
-        NeighborBuilder::new(0.3, 0.0, 0.5, Search::AllPairs).build(
+        NeighborBuilder::new(skin, 0.0, r[0], Search::AllPairs).build(
             &mut all,
-            &domain,
-            &x,
-            &r,
-            &id,
+            domain,
+            x,
+            r,
+            id,
             |_, _| true,
         );
+        Searched {
+            builder,
+            xs,
+            ids,
+            cells,
+            all,
+        }
+    }
+
+    #[test]
+    fn cell_search_finds_exactly_the_all_pairs_list_with_pairs_oriented_by_id() {
+        let (domain, x, r, id) = random_scene(300, 7);
+        let Searched {
+            ids, cells, all, ..
+        } = search_both(&domain, &x, &r, &id, 0.3);
         assert!(!cells.p.is_empty());
         assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
         assert!((0..cells.p.len()).all(|k| ids[cells.p[k] as usize] < ids[cells.i[k] as usize]));
@@ -438,16 +461,7 @@ mod tests {
                 .collect();
             let r = vec![0.3; n];
             let id: Vec<u32> = (0..n as u32).collect();
-            let mut b = NeighborBuilder::new(0.1, 0.0, 0.3, Search::Cells);
-            let mut order = Vec::new();
-            b.order(&domain, &x, &id, &mut order);
-            let xs: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
-            let ids: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
-            let mut cells = PairList::default();
-            b.build(&mut cells, &domain, &xs, &r, &ids, |_, _| true);
-            let mut all = PairList::default();
-            NeighborBuilder::new(0.1, 0.0, 0.3, Search::AllPairs)
-                .build(&mut all, &domain, &x, &r, &id, |_, _| true);
+            let Searched { builder: b, xs, ids, cells, all } = search_both(&domain, &x, &r, &id, 0.1);
             proptest::prop_assert_eq!(sorted_id_pairs(&cells, &ids), sorted_id_pairs(&all, &id));
             // two searches over consecutive owner ranges, concatenated, are the one search
             let m = (split * n as f64) as usize;

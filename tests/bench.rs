@@ -7,21 +7,13 @@ mod common;
 #[test]
 fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
     let dir = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
-        .current_dir(common::root())
-        .args([
-            "bench", "--steps", "300", "--rounds", "1", "--np", "1,2", "--out",
-        ])
-        .arg(dir.path())
-        .arg("--from")
-        .arg(common::shared("states/mercury_t143.85.data"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let state = common::shared("states/mercury_t143.85.data");
+    let args = [
+        "bench", "--steps", "300", "--rounds", "1", "--np", "1,2", "--out",
+    ];
+    let mut args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    args.extend([dir.path().as_os_str(), "--from".as_ref(), state.as_os_str()]);
+    let out = common::verdem_ok(args);
     let csv = std::fs::read_to_string(dir.path().join("bench.csv")).unwrap();
     let rows: Vec<(String, String, f64)> = csv
         .lines()

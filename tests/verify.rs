@@ -138,19 +138,15 @@ fn the_kinematics_command_writes_the_forces_of_the_driver() {
     let dir = tempfile::tempdir().unwrap();
     let (motion, forces) = (dir.path().join("MOTION.csv"), dir.path().join("FORCES.csv"));
     std::fs::write(&motion, motion_csv(&rows)).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
-        .arg("kinematics")
-        .arg(common::root().join("cases/verify/objectivity.toml"))
-        .arg(&motion)
-        .arg("--out")
-        .arg(&forces)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::verdem_ok([
+        "kinematics".as_ref(),
+        common::root()
+            .join("cases/verify/objectivity.toml")
+            .as_os_str(),
+        motion.as_os_str(),
+        "--out".as_ref(),
+        forces.as_os_str(),
+    ]);
     // the command reads the motion back (quaternions normalised) and drives the same law
     let read = verdem::kinematics::parse_motion("m", &motion_csv(&rows)).unwrap();
     let expected = forces_csv(&drive(

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 use verdem::case::Case;
 use verdem::engine::{self, Overrides};
@@ -22,6 +23,22 @@ pub fn shared(rel: &str) -> PathBuf {
         p.display()
     );
     p
+}
+
+/// Runs the verdem binary with `args` from the repository root and returns its output, once it
+/// has exited successfully (its stderr is the failure message otherwise).
+pub fn verdem_ok<S: AsRef<std::ffi::OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 /// The quick shear case.
