@@ -52,3 +52,66 @@ fn variants_change_what_they_should_and_nothing_else() {
     let table = verdem::tradeoff::markdown(&out);
     assert_eq!(table.lines().count(), 2 + 10);
 }
+
+/// The recorded trade over 300 time units (golden/tradeoff, see its provenance.toml): its
+/// compare.md is what `verdem compare` gives on the stored profiles, and what the README says of
+/// it holds. The floor is the largest χ² of the same-physics runs (the replica and the finer
+/// time steps) in each profile.
+#[test]
+fn the_recorded_trade_over_300_time_units_says_what_the_readme_says() {
+    use verdem::cg::table::Table;
+    let dir = common::root().join("golden/tradeoff");
+    let names = [
+        "reference",
+        "replica",
+        "dt_tc_25",
+        "dt_tc_100",
+        "dt_tc_200",
+        "kn_10",
+        "kn_100",
+    ];
+    let tables: Vec<(String, Table)> = names
+        .iter()
+        .map(|n| {
+            let t = Table::read(&dir.join(format!("{n}.profiles.csv"))).unwrap();
+            (n.to_string(), t)
+        })
+        .collect();
+    let rows = verdem::cg::compare::compare(&tables[0].1, &tables[1..]).unwrap();
+    assert_eq!(
+        verdem::cg::compare::markdown("reference", &rows),
+        std::fs::read_to_string(dir.join("compare.md")).unwrap()
+    );
+    let chi2 = |name: &str| rows.iter().find(|r| r.name == name).unwrap().chi2;
+    let floor: Vec<f64> = (0..5)
+        .map(|f| {
+            ["replica", "dt_tc_100", "dt_tc_200"]
+                .iter()
+                .map(|n| chi2(n)[f])
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let [vx, nu, t, p, tau] = [0, 1, 2, 3, 4];
+    let above = |name: &str, f: usize| chi2(name)[f] > floor[f];
+    // dt = tc/25: within the floor in vx, T, p and τ, just above it in ν
+    assert!(
+        [vx, t, p, tau].iter().all(|&f| !above("dt_tc_25", f)),
+        "{floor:?}"
+    );
+    // kn/10: within it in vx and τ, at it in p (within 10 %), above it in ν and T
+    assert!(!above("kn_10", vx) && !above("kn_10", tau) && chi2("kn_10")[p] < 1.1 * floor[p]);
+    assert!(above("kn_10", t));
+    // kn/100: within it in vx, T and p, above it in ν and τ
+    assert!([vx, t, p].iter().all(|&f| !above("kn_100", f)));
+    assert!(above("kn_100", tau));
+    // the ν profile's χ² is above the floor for every variant that changes the contact
+    // dynamics, rising as they change more
+    let nu_chi2: Vec<f64> = ["dt_tc_25", "kn_10", "kn_100"]
+        .iter()
+        .map(|n| chi2(n)[nu])
+        .collect();
+    assert!(
+        nu_chi2[0] > floor[nu] && nu_chi2.windows(2).all(|w| w[0] < w[1]),
+        "{nu_chi2:?}"
+    );
+}
