@@ -191,15 +191,15 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             .find(|x| x.config == Config::Verdem { threads, copies })
     };
     if let (Some(one), Some(two)) = (find(1, 1), find(2, 1)) {
+        let speedup = paired_ratio(one, two);
         s.push_str(&format!(
-            "\nverdem 2 threads / 1 thread: {:.2} (median over the rounds of the ratio within a round)",
-            paired_ratio(one, two)
+            "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round)"
         ));
         if let Some(pair) = find(1, 2) {
             let ceiling = paired_ratio(one, pair);
             s.push_str(&format!(
                 "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
-                100.0 * paired_ratio(one, two) / ceiling
+                100.0 * speedup / ceiling
             ));
         }
         s.push('\n');

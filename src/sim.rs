@@ -598,13 +598,13 @@ impl Crew<'_> {
 }
 
 /// Part `part` of `0..n` split into `parts` nearly equal contiguous ranges.
-fn chunk(n: usize, parts: usize, part: usize) -> (usize, usize) {
-    (n * part / parts, n * (part + 1) / parts)
+fn chunk(n: usize, parts: usize, part: usize) -> std::ops::Range<usize> {
+    n * part / parts..n * (part + 1) / parts
 }
 
-/// `to[k] = from[order[k]]` for `k` in `a..b`.
-fn permute_range<T: Copy>(from: &[T], to: &mut [T], order: &[u32], a: usize, b: usize) {
-    for (t, &o) in to[a..b].iter_mut().zip(&order[a..b]) {
+/// `to[k] = from[order[k]]` for `k` in `range`.
+fn permute_range<T: Copy>(from: &[T], to: &mut [T], order: &[u32], range: std::ops::Range<usize>) {
+    for (t, &o) in to[range.clone()].iter_mut().zip(&order[range]) {
         *t = from[o as usize];
     }
 }
@@ -650,18 +650,18 @@ impl ListState<'_> {
         }
         crew.sync();
         for part in crew.parts(threads) {
-            let (a, b) = chunk(n, threads, part);
+            let r = chunk(n, threads, part);
             let (from, to, o) = (&*pt, &mut s.next, &s.order);
-            permute_range(&from.x, &mut to.x, o, a, b);
-            permute_range(&from.v, &mut to.v, o, a, b);
-            permute_range(&from.w, &mut to.w, o, a, b);
-            permute_range(&from.f, &mut to.f, o, a, b);
-            permute_range(&from.t, &mut to.t, o, a, b);
-            permute_range(&from.radius, &mut to.radius, o, a, b);
-            permute_range(&from.inv_mass, &mut to.inv_mass, o, a, b);
-            permute_range(&from.inv_inertia, &mut to.inv_inertia, o, a, b);
-            permute_range(&from.motion, &mut to.motion, o, a, b);
-            permute_range(self.id, &mut s.next_id, o, a, b);
+            permute_range(&from.x, &mut to.x, o, r.clone());
+            permute_range(&from.v, &mut to.v, o, r.clone());
+            permute_range(&from.w, &mut to.w, o, r.clone());
+            permute_range(&from.f, &mut to.f, o, r.clone());
+            permute_range(&from.t, &mut to.t, o, r.clone());
+            permute_range(&from.radius, &mut to.radius, o, r.clone());
+            permute_range(&from.inv_mass, &mut to.inv_mass, o, r.clone());
+            permute_range(&from.inv_inertia, &mut to.inv_inertia, o, r.clone());
+            permute_range(&from.motion, &mut to.motion, o, r.clone());
+            permute_range(self.id, &mut s.next_id, o, r);
         }
         crew.sync();
         if crew.leads() {
@@ -681,10 +681,7 @@ impl ListState<'_> {
                 &pt.x,
                 &pt.radius,
                 self.id,
-                {
-                    let (a, b) = chunk(n, threads, part);
-                    a..b
-                },
+                chunk(n, threads, part),
                 |a, b| motion[a] == Motion::Free || motion[b] == Motion::Free,
                 (found_p, found_i),
             );
