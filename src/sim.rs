@@ -12,9 +12,10 @@
 //!    v += (F/m + g)·dt/2, ω += T/I·dt/2; t += dt (a running sum).
 //!
 //! Steps 4 of one step and 1 of the next touch only one particle each, so they run fused in one
-//! pass. With T threads every thread runs this loop on its own particles and pairs, and the
-//! threads meet at a barrier after the per-particle pass and after the pair pass: two barriers
-//! per step. No float is ever summed in an order that depends on the thread count, the memory
+//! pass. With T threads every thread runs this loop; each pass is cut into chunks (contiguous
+//! particles, contiguous pairs) that the threads take from a [`WorkQueue`], their own share
+//! first and then what is left of the others', and the threads meet at a barrier after the
+//! per-particle pass and after the pair pass: two barriers per step. No float is ever summed in an order that depends on the thread count, the memory
 //! order of the particles, the skin or the cell size, so results are bitwise identical for all.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -24,7 +25,7 @@ use crate::contact::{ContactLaw, PairForce, PairInput};
 use crate::domain::Domain;
 use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::{Motion, Particles};
-use crate::team::{balanced_ranges, Shared, SpinBarrier};
+use crate::team::{balanced_ranges, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 
 /// Wall-clock time spent in each stage, in nanoseconds, measured on thread 0.
@@ -122,7 +123,7 @@ struct Scratch {
     /// The particles and ids in the new memory order, filled by the team and then swapped in.
     next: Particles,
     next_id: Vec<u32>,
-    /// The pairs each part of a build's search found, concatenated into the pair list.
+    /// The pairs each chunk of a build's search found, concatenated into the pair list.
     found: Vec<(Vec<u32>, Vec<u32>)>,
     /// P and I of the pairs in their final order, filled by the team and then swapped in.
     next_p: Vec<u32>,
@@ -134,21 +135,38 @@ struct Scratch {
     bin: Vec<u8>,
     /// Build-order index of each pair, in the order of the shares' bins.
     sorted: Vec<u32>,
-    particle_ranges: Vec<(usize, usize)>,
-    /// Relative speed of each thread (work per second) in the particle pass [0] and in the
-    /// pair pass [1], learnt from the busy times measured between builds: every pass ends at a
-    /// barrier, so each is balanced on its own. Shares never change a bit of the results.
-    speed: [Vec<f64>; 2],
-    /// Total weight of each thread's share of each pass at the last build.
-    range_weight: [Vec<u64>; 2],
-    /// Each thread's pairs, before they are split into interior and boundary parts.
-    pair_bounds: Vec<(usize, usize)>,
-    /// Bounds of each thread's pair classes: class `c` is `ranges[c]..ranges[c + 1]`, each
-    /// sorted by gap bin (see [`CLASSES`]).
+    /// Threads of the step.
+    threads: usize,
+    /// The particle pass's chunks: ranges of particles of equal cost.
+    particle_chunks: Vec<(usize, usize)>,
+    /// The pair pass's chunks: ranges of pairs of equal count, in build order.
+    pair_chunks: Vec<(usize, usize)>,
+    /// Bounds of each pair chunk's classes after sorting: class `c` is `ranges[c]..ranges[c +
+    /// 1]`, each sorted by gap bin (see [`CLASSES`]).
     pair_ranges: Vec<[usize; CLASSES + 1]>,
+    /// End of the live prefix of each pair chunk's classes (see `run`); reset at every build.
+    live: Vec<[usize; CLASSES]>,
     /// Gap |r| − (r_P + r_I) of each pair at the build, rounded down to a sixteenth of the skin
     /// (length).
     gap: Vec<f64>,
+}
+
+impl Scratch {
+    /// Chunks of each pass: one for a team of one.
+    fn chunks(&self) -> usize {
+        if self.threads == 1 {
+            1
+        } else {
+            self.threads * CHUNKS_PER_THREAD
+        }
+    }
+
+    /// Starts every pair chunk's live prefixes empty.
+    fn reset_live(&mut self) {
+        for (live, ranges) in self.live.iter_mut().zip(&self.pair_ranges) {
+            live.copy_from_slice(&ranges[..CLASSES]);
+        }
+    }
 }
 
 /// Gap bins of the pair list: one of overlapping pairs, then sixteen of a sixteenth of the skin
@@ -160,6 +178,11 @@ const GAP_BINS: usize = 18;
 /// the particles' speed classes: a pair's gap closes at most by the sum of its particles' class
 /// displacement bounds, so pairs of slow particles are visited later.
 const CLASSES: usize = 6;
+
+/// Chunks of each pass per thread when the team has more than one: enough that a thread done
+/// early takes over a small piece of its partner's work (the wait at a pass's end is at most
+/// about one chunk), few enough that handing them out costs nothing (one atomic operation each).
+const CHUNKS_PER_THREAD: usize = 16;
 
 /// A free particle is fast, at a build, when its speed exceeds this fraction of the fastest
 /// free particle's.
@@ -203,9 +226,7 @@ impl Core {
             kind: Vec::new(),
             builder,
             scratch: Scratch {
-                particle_ranges: vec![(0, 0); threads],
-                found: vec![(Vec::new(), Vec::new()); threads],
-                speed: [vec![1.0; threads], vec![1.0; threads]],
+                threads,
                 ..Scratch::default()
             },
         }
@@ -237,8 +258,7 @@ impl Core {
     /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
     pub fn rebuild(&mut self) {
         let domain = self.domain.clone();
-        self.list_state()
-            .rebuild(Crew::Solo, &domain, &[Vec::new(), Vec::new()]);
+        self.list_state().rebuild(Crew::Solo, &domain);
         self.moved_bound = [0.0; 2];
     }
 
@@ -411,12 +431,15 @@ impl<L: ContactLaw> Simulation<L> {
         let vmax2: Vec<[AtomicU64; 2]> = (0..threads)
             .map(|_| [AtomicU64::new(0), AtomicU64::new(0)])
             .collect();
-        let busy: [Vec<AtomicU64>; 2] =
-            [0, 1].map(|_| (0..threads).map(|_| AtomicU64::new(0)).collect());
+        let chunks = core.scratch.chunks();
+        let particle_queue = WorkQueue::new(threads, chunks);
+        let pair_queue = WorkQueue::new(threads, chunks);
+        let rebuild_queue = WorkQueue::new(threads, chunks);
         let skin = core.skin();
         let bound0 = core.moved_bound;
         // Velocities or forces may have been set since the last run.
         core.quiet.fill(false);
+        core.scratch.reset_live();
         let domain = core.domain.clone();
         let view = StepView {
             law: &self.law,
@@ -438,29 +461,35 @@ impl<L: ContactLaw> Simulation<L> {
                     clock = now;
                 }
             };
+            // The particle pass over the chunks this thread takes; the largest squared speeds.
+            let particles = |kick_end: bool, drift: bool| {
+                let mut v2 = [0.0f64; 2];
+                while let Some(c) = particle_queue.next(tid) {
+                    // SAFETY: a chunk is run by one thread; see the loop below.
+                    let seen = unsafe {
+                        let l = list.get();
+                        let (a, b) = l.scratch.particle_chunks[c];
+                        particle_pass::<L, ROT, GRAV>(&view, l, a, b, kick_end, drift)
+                    };
+                    for (m, s) in v2.iter_mut().zip(seen) {
+                        *m = m.max(s);
+                    }
+                }
+                v2
+            };
             let mut bound = bound0;
-            // this thread's compute time in each pass since the last build (ns), for the load
-            // balance
-            let mut busy_local = [0u64; 2];
-            // Ends of the live prefixes of this thread's pair classes.
-            let mut live: Option<[usize; CLASSES]> = None;
             for s in 0..steps {
                 // SAFETY (all blocks below): phases are separated by barriers; in each phase a
-                // thread writes only its own particle range or pair range, and a rebuild runs on
-                // thread 0 alone between two barriers.
-                let t_start = Instant::now();
-                let v2 = unsafe {
-                    let l = list.get();
-                    let (a, b) = l.scratch.particle_ranges[tid];
-                    particle_pass::<L, ROT, GRAV>(&view, l, a, b, s > 0, true)
-                };
-                busy_local[0] += t_start.elapsed().as_nanos() as u64;
+                // thread writes only the particles or pairs of the chunks it takes, and a
+                // rebuild's serial phases run on thread 0 alone between two barriers.
+                let v2 = particles(s > 0, true);
                 for (slot, v) in vmax2[tid].iter().zip(v2) {
                     slot.store(v.to_bits(), Ordering::Relaxed);
                 }
                 lap(&mut local.integrate);
                 barrier.wait();
                 lap(&mut local.wait);
+                particle_queue.refill(tid);
                 // Every thread derives the same bounds from the same numbers.
                 for (kind, b) in bound.iter_mut().enumerate() {
                     let m = vmax2
@@ -474,53 +503,47 @@ impl<L: ContactLaw> Simulation<L> {
                 let closed = [2.0 * bound[0], bound[0] + bound[1], 2.0 * bound[1]];
                 if closed.into_iter().fold(0.0, f64::max) > skin {
                     bound = [0.0; 2];
-                    live = None;
-                    for pass in 0..2 {
-                        busy[pass][tid].store(busy_local[pass], Ordering::Relaxed);
-                    }
-                    busy_local = [0; 2];
                     barrier.wait();
                     let crew = Crew::Member {
                         tid,
                         barrier: &barrier,
+                        queue: &rebuild_queue,
                     };
-                    unsafe { list.get().rebuild(crew, view.domain, &busy) };
+                    unsafe { list.get().rebuild(crew, view.domain) };
                     barrier.wait();
                     lap(&mut local.neighbor);
                 }
-                unsafe {
-                    let l = list.get();
-                    let seg = l.scratch.pair_ranges[tid];
-                    let ends = live.get_or_insert_with(|| std::array::from_fn(|c| seg[c]));
-                    // A pair whose gap at the build exceeds what its particles can have closed
-                    // cannot touch yet; its slot stays inactive, exactly as a full pass would
-                    // leave it.
-                    let gap = &l.scratch.gap;
-                    for (c, end) in ends.iter_mut().enumerate() {
-                        let reach = closed[c % 3] + 1e-9;
-                        while *end < seg[c + 1] && gap[*end] <= reach {
-                            *end += 1;
+                while let Some(c) = pair_queue.next(tid) {
+                    unsafe {
+                        let l = list.get();
+                        let seg = l.scratch.pair_ranges[c];
+                        let ends = &mut l.scratch.live[c];
+                        // A pair whose gap at the build exceeds what its particles can have
+                        // closed cannot touch yet; its slot stays inactive, exactly as a full
+                        // pass would leave it.
+                        let gap = &l.scratch.gap;
+                        for (class, end) in ends.iter_mut().enumerate() {
+                            let reach = closed[class % 3] + 1e-9;
+                            while *end < seg[class + 1] && gap[*end] <= reach {
+                                *end += 1;
+                            }
+                        }
+                        let ends = *ends;
+                        for class in 0..CLASSES {
+                            if class < CLASSES / 2 {
+                                pair_pass::<L, false>(&view, l, seg[class], ends[class]);
+                            } else {
+                                pair_pass::<L, true>(&view, l, seg[class], ends[class]);
+                            }
                         }
                     }
-                    let t_start = Instant::now();
-                    for c in 0..CLASSES {
-                        if c < CLASSES / 2 {
-                            pair_pass::<L, false>(&view, l, seg[c], ends[c]);
-                        } else {
-                            pair_pass::<L, true>(&view, l, seg[c], ends[c]);
-                        }
-                    }
-                    busy_local[1] += t_start.elapsed().as_nanos() as u64;
                 }
                 lap(&mut local.forces);
                 barrier.wait();
                 lap(&mut local.wait);
+                pair_queue.refill(tid);
             }
-            unsafe {
-                let l = list.get();
-                let (a, b) = l.scratch.particle_ranges[tid];
-                particle_pass::<L, ROT, GRAV>(&view, l, a, b, true, false);
-            }
+            particles(true, false);
             lap(&mut local.integrate);
             (local, bound)
         };
@@ -565,25 +588,19 @@ struct ListState<'a> {
 }
 
 /// Who runs a rebuild: the team, each thread between the same barriers, or one thread alone
-/// (outside a run), which then does every thread's part itself.
+/// (outside a run), which then does every chunk of each parallel phase itself.
 #[derive(Clone, Copy)]
 enum Crew<'b> {
     Solo,
     Member {
         tid: usize,
         barrier: &'b SpinBarrier,
+        /// The chunks of the parallel phases, as many as the passes have.
+        queue: &'b WorkQueue,
     },
 }
 
 impl Crew<'_> {
-    /// The parts of each parallel phase this thread does, of `parts`.
-    fn parts(self, parts: usize) -> std::ops::Range<usize> {
-        match self {
-            Crew::Solo => 0..parts,
-            Crew::Member { tid, .. } => tid..tid + 1,
-        }
-    }
-
     /// Whether this thread does the serial phases.
     fn leads(self) -> bool {
         matches!(self, Crew::Solo | Crew::Member { tid: 0, .. })
@@ -593,6 +610,26 @@ impl Crew<'_> {
     fn sync(self) {
         if let Crew::Member { barrier, .. } = self {
             barrier.wait();
+        }
+    }
+
+    /// A parallel phase: runs `job` on each of the `chunks` chunks this thread takes (all of
+    /// them, alone), then waits for the whole crew.
+    fn share(self, chunks: usize, mut job: impl FnMut(usize)) {
+        match self {
+            Crew::Solo => (0..chunks).for_each(job),
+            Crew::Member {
+                tid,
+                barrier,
+                queue,
+            } => {
+                while let Some(c) = queue.next(tid) {
+                    job(c);
+                }
+                barrier.wait();
+                // The next parallel phase starts after a serial one and its barrier.
+                queue.refill(tid);
+            }
         }
     }
 }
@@ -611,21 +648,20 @@ fn permute_range<T: Copy>(from: &[T], to: &mut [T], order: &[u32], range: std::o
 
 impl ListState<'_> {
     /// Re-orders the particles by cell, rebuilds the pair list, carries every contact's history
-    /// over (matched by original ids), and re-balances the threads' ranges; `busy` holds each
-    /// thread's compute time (ns) in the particle [0] and the pair [1] pass since the last build,
-    /// when known. The serial phases run on the lead thread, the others (permutation, search,
-    /// sorting of the shares, history) in parts, one a thread; the results do not depend on the
-    /// crew.
+    /// over (matched by original ids), and splits both passes into chunks. The serial phases
+    /// run on the lead thread, the others (permutation, search, sorting of the pair chunks,
+    /// history) in chunks that the crew shares out; the results do not depend on the crew.
     ///
     /// # Safety (team)
     /// Every thread of the crew calls this with the same arguments; in a parallel phase each
-    /// writes only its part's ranges, and no vector is resized outside the lead's phases.
-    fn rebuild(&mut self, crew: Crew<'_>, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
+    /// writes only the ranges of the chunks it takes, and no vector is resized outside the
+    /// lead's phases.
+    fn rebuild(&mut self, crew: Crew<'_>, domain: &Domain) {
         let t0 = Instant::now();
         let s = &mut *self.scratch;
         let pt = &mut *self.particles;
-        let threads = s.particle_ranges.len();
         let n = pt.len();
+        let chunks = s.chunks();
         if crew.leads() {
             // History of the contacts, by original ids.
             s.old_keys.clear();
@@ -647,10 +683,11 @@ impl ListState<'_> {
                 s.next = pt.clone();
             }
             s.next_id.resize(n, 0);
+            s.found.resize_with(chunks, Default::default);
         }
         crew.sync();
-        for part in crew.parts(threads) {
-            let r = chunk(n, threads, part);
+        crew.share(chunks, |part| {
+            let r = chunk(n, chunks, part);
             let (from, to, o) = (&*pt, &mut s.next, &s.order);
             permute_range(&from.x, &mut to.x, o, r.clone());
             permute_range(&from.v, &mut to.v, o, r.clone());
@@ -662,15 +699,14 @@ impl ListState<'_> {
             permute_range(&from.inv_inertia, &mut to.inv_inertia, o, r.clone());
             permute_range(&from.motion, &mut to.motion, o, r.clone());
             permute_range(self.id, &mut s.next_id, o, r);
-        }
-        crew.sync();
+        });
         if crew.leads() {
             std::mem::swap(pt, &mut s.next);
             std::mem::swap(self.id, &mut s.next_id);
             self.builder.prepare(domain, &pt.x);
         }
         crew.sync();
-        for part in crew.parts(threads) {
+        crew.share(chunks, |part| {
             let motion = &pt.motion;
             let (found_p, found_i) = &mut s.found[part];
             found_p.clear();
@@ -681,12 +717,11 @@ impl ListState<'_> {
                 &pt.x,
                 &pt.radius,
                 self.id,
-                chunk(n, threads, part),
+                chunk(n, chunks, part),
                 |a, b| motion[a] == Motion::Free || motion[b] == Motion::Free,
                 (found_p, found_i),
             );
-        }
-        crew.sync();
+        });
         if crew.leads() {
             self.pairs.p.clear();
             self.pairs.i.clear();
@@ -694,27 +729,24 @@ impl ListState<'_> {
                 self.pairs.p.extend_from_slice(found_p);
                 self.pairs.i.extend_from_slice(found_i);
             }
-            self.plan_shares(domain, busy);
+            self.plan_chunks(domain);
         }
         crew.sync();
-        for part in crew.parts(threads) {
-            self.sort_share(domain, part);
-        }
-        crew.sync();
+        crew.share(chunks, |part| self.sort_chunk(domain, part));
         if crew.leads() {
             let s = &mut *self.scratch;
             std::mem::swap(&mut self.pairs.p, &mut s.next_p);
             std::mem::swap(&mut self.pairs.i, &mut s.next_i);
             self.pairs.index(n, self.id, &mut s.fill);
+            s.reset_live();
             self.times.neighbor += t0.elapsed().as_nanos() as u64;
             self.times.rebuilds += 1;
         }
     }
 
     /// Lead phase of a rebuild, once the pairs are found: the particles' flags and speed
-    /// classes, the threads' shares of both passes, and room for the pairs' new order and
-    /// history.
-    fn plan_shares(&mut self, domain: &Domain, busy: &[Vec<AtomicU64>; 2]) {
+    /// classes, the chunks of both passes, and room for the pairs' new order and history.
+    fn plan_chunks(&mut self, domain: &Domain) {
         let s = &mut *self.scratch;
         let pt = &*self.particles;
         let n_pairs = self.pairs.p.len();
@@ -732,37 +764,14 @@ impl ListState<'_> {
         self.kind.extend(
             (0..pt.len()).map(|a| u8::from(pt.inv_mass[a] == 0.0 || pt.v[a].norm() > slow)),
         );
-        // Threads' shares: contiguous particles (a slab of space) and the pairs they own.
-        let threads = s.particle_ranges.len();
-        for pass in 0..2 {
-            let ns = |t: usize| busy[pass][t].load(Ordering::Relaxed) as f64;
-            if busy[pass].len() == threads
-                && s.range_weight[pass].len() == threads
-                && (0..threads).all(|t| ns(t) > 0.0)
-            {
-                let measured = |t: usize| s.range_weight[pass][t] as f64 / ns(t);
-                let mean = (0..threads).map(measured).sum::<f64>() / threads as f64;
-                for t in 0..threads {
-                    s.speed[pass][t] = 0.5 * s.speed[pass][t] + 0.5 * measured(t) / mean;
-                }
-            }
-        }
+        // Chunks: contiguous particles (a slab of space) of equal cost, and contiguous pairs of
+        // equal count; the pair list is in owner (memory, so space) order, so a chunk's pairs
+        // lie mostly among one particle chunk and its neighbours.
         let inv_mass = &pt.inv_mass;
-        // Each pass is balanced on its own (every pass ends at a barrier): particles by their
-        // cost, pairs by count; the pair list is in owner (memory, so space) order, so a
-        // thread's pairs lie mostly among its own particles.
+        let chunks = s.chunks();
         let weight = |a: usize| if inv_mass[a] > 0.0 { 8 } else { 2 };
-        balanced_ranges(pt.len(), &s.speed[0], weight, &mut s.particle_ranges);
-        balanced_ranges(n_pairs, &s.speed[1], |_| 2, &mut s.pair_bounds);
-        let [particle_weight, pair_weight] = &mut s.range_weight;
-        particle_weight.clear();
-        particle_weight.extend(
-            s.particle_ranges
-                .iter()
-                .map(|&(a, b)| (a..b).map(weight).sum::<u64>()),
-        );
-        pair_weight.clear();
-        pair_weight.extend(s.pair_bounds.iter().map(|&(a, b)| 2 * (b - a) as u64));
+        balanced_ranges(pt.len(), chunks, weight, &mut s.particle_chunks);
+        balanced_ranges(n_pairs, chunks, |_| 1, &mut s.pair_chunks);
         let skin = self.builder.skin;
         let interior = |a: usize| {
             (0..3).all(|k| {
@@ -777,7 +786,8 @@ impl ListState<'_> {
         s.gap.resize(n_pairs, 0.0);
         s.next_p.resize(n_pairs, 0);
         s.next_i.resize(n_pairs, 0);
-        s.pair_ranges.resize(threads, [0; CLASSES + 1]);
+        s.pair_ranges.resize(chunks, [0; CLASSES + 1]);
+        s.live.resize(chunks, [0; CLASSES]);
         self.xi.clear();
         self.xi.resize(n_pairs, Vec3::zeros());
         self.active.clear();
@@ -785,16 +795,16 @@ impl ListState<'_> {
         self.out.resize(n_pairs, PairForce::default());
     }
 
-    /// Parallel phase of a rebuild: share `part` of the pairs in its final order and with its
-    /// history. Within a share, interior pairs (no periodic image needed until the next build)
+    /// Parallel phase of a rebuild: chunk `part` of the pairs in its final order and with its
+    /// history. Within a chunk, interior pairs (no periodic image needed until the next build)
     /// come first, then the others; each part in bins of gap (GAP_BINS − 1 bins of a sixteenth
     /// of the skin, after one of all overlapping pairs), each bin in build (owner memory) order.
     /// A step visits only the prefix of bins whose gap the particles can have closed (see
     /// `live`), in near-memory order.
-    fn sort_share(&mut self, domain: &Domain, part: usize) {
+    fn sort_chunk(&mut self, domain: &Domain, part: usize) {
         let s = &mut *self.scratch;
         let pt = &*self.particles;
-        let (pa, pb) = s.pair_bounds[part];
+        let (pa, pb) = s.pair_chunks[part];
         let skin = self.builder.skin;
         let bin_width = skin / 16.0;
         for k in pa..pb {
@@ -816,7 +826,7 @@ impl ListState<'_> {
                 3 * usize::from(!plain) + usize::from(self.kind[p]) + usize::from(self.kind[i]);
             s.bin[k] = (class * GAP_BINS + bin) as u8;
         }
-        // A stable counting sort of the share by (class, bin).
+        // A stable counting sort of the chunk by (class, bin).
         let mut next = [0usize; CLASSES * GAP_BINS];
         for &b in &s.bin[pa..pb] {
             next[b as usize] += 1;
