@@ -17,6 +17,8 @@ use crate::Vec3;
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub threads: Option<usize>,
+    /// Bind the team's threads to CPUs (default: yes; see [`Core::bind`]).
+    pub bind: Option<bool>,
     pub skin: Option<f64>,
     pub cell: Option<f64>,
 }
@@ -98,5 +100,6 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         o.threads.unwrap_or(case.run.threads),
     );
     core.time = scene.time;
+    core.bind = o.bind.unwrap_or(true);
     with_law(&case.contact, BuildSimulation(core))
 }

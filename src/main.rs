@@ -32,6 +32,11 @@ struct Common {
     /// Worker threads of the time step.
     #[arg(long)]
     threads: Option<usize>,
+    /// Leave the threads to the scheduler: by default thread t of a team of two or more runs on
+    /// the t-th CPU the process may use (start two multi-threaded runs side by side with
+    /// `taskset -c` on disjoint CPUs).
+    #[arg(long)]
+    no_bind: bool,
     /// Pair-list skin (length).
     #[arg(long)]
     skin: Option<f64>,
@@ -239,6 +244,7 @@ fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::sim::Engine>)>
     let scene = scene::build(&case, common.init.as_deref())?;
     let o = Overrides {
         threads: common.threads,
+        bind: common.no_bind.then_some(false),
         skin: common.skin,
         cell: common.cell,
     };

@@ -25,7 +25,7 @@ use crate::contact::{ContactLaw, PairForce, PairInput};
 use crate::domain::Domain;
 use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::{Motion, Particles};
-use crate::team::{balanced_ranges, Shared, SpinBarrier, WorkQueue};
+use crate::team::{balanced_ranges, Bound, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 
 /// Wall-clock time spent in each stage, in nanoseconds, measured on thread 0.
@@ -94,6 +94,9 @@ pub struct Core {
     pub moved_bound: [f64; 2],
     /// Worker threads of the step.
     pub threads: usize,
+    /// Whether a team of more than one thread binds thread t to the t-th CPU the process may
+    /// run on, while it runs (when the team fits on distinct CPUs); the default.
+    pub bind: bool,
     /// Whether the force evaluation before the first step advances the tangential springs by
     /// one step, as MercuryDPM's does (true, the default); LAMMPS and LIGGGHTS skip the
     /// history update during their setup (`update->setupflag`), which cross-runs mirror.
@@ -218,6 +221,7 @@ impl Core {
             forces_ready: false,
             moved_bound: [0.0; 2],
             threads,
+            bind: true,
             setup_advances_history: true,
             times: StageTimes::default(),
             touched: Vec::new(),
@@ -435,6 +439,7 @@ impl<L: ContactLaw> Simulation<L> {
         let particle_queue = WorkQueue::new(threads, chunks);
         let pair_queue = WorkQueue::new(threads, chunks);
         let rebuild_queue = WorkQueue::new(threads, chunks);
+        let bind = core.bind && threads > 1;
         let skin = core.skin();
         let bound0 = core.moved_bound;
         // Velocities or forces may have been set since the last run.
@@ -452,6 +457,11 @@ impl<L: ContactLaw> Simulation<L> {
         // for that alone, while the other threads wait at a barrier.
         let list = Shared::new(core.list_state());
         let work = |tid: usize| {
+            let _bound = if bind {
+                Bound::to_nth_cpu(tid, threads)
+            } else {
+                None
+            };
             let mut local = StageTimes::default();
             let mut clock = Instant::now();
             let mut lap = |slot: &mut u64| {

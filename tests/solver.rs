@@ -65,30 +65,32 @@ fn cell_list_gives_the_same_trajectory_as_all_pairs() {
     assert_eq!(a, b);
 }
 
-/// Deterministic mode: the same bits for 1, 2 and 3 threads, any skin and any cell size, over
-/// 20000 steps of the developed, contact-rich state.
+/// Deterministic mode: the same bits for 1, 2 and 3 threads, bound to CPUs or not, any skin and
+/// any cell size, over 20000 steps of the developed, contact-rich state.
 #[test]
 fn threads_skin_and_cell_size_do_not_change_a_bit() {
     let case = quick_case();
     let state = shared("states/mercury_t143.85.data");
-    let run = |threads, skin, cell| {
+    let run = |threads, bind, skin, cell| {
         let mut e = engine(
             &case,
             Some(&state),
             Overrides {
                 threads: Some(threads),
+                bind: Some(bind),
                 skin: Some(skin),
                 cell: Some(cell),
             },
         );
         hash_after(e.as_mut(), 20_000)
     };
-    let reference = run(1, 0.1, 0.0);
-    assert_eq!(run(2, 0.1, 0.0), reference, "2 threads");
-    // three parts of every parallel phase, on two cores
-    assert_eq!(run(3, 0.1, 0.0), reference, "3 threads");
-    assert_eq!(run(2, 0.35, 0.0), reference, "skin 0.35");
-    assert_eq!(run(2, 0.05, 2.7), reference, "skin 0.05, cell 2.7");
+    let reference = run(1, true, 0.1, 0.0);
+    assert_eq!(run(2, true, 0.1, 0.0), reference, "2 threads");
+    assert_eq!(run(2, false, 0.1, 0.0), reference, "2 threads, not bound");
+    // more threads than cores: chunks of every pass and phase change hands
+    assert_eq!(run(3, true, 0.1, 0.0), reference, "3 threads");
+    assert_eq!(run(2, true, 0.35, 0.0), reference, "skin 0.35");
+    assert_eq!(run(2, true, 0.05, 2.7), reference, "skin 0.05, cell 2.7");
 }
 
 /// The hash sees every bit: one ulp in one velocity changes it.
