@@ -15,8 +15,9 @@
 //! pass. With T threads every thread runs this loop; each pass is cut into chunks (contiguous
 //! particles, contiguous pairs) that the threads take from a [`WorkQueue`], their own share
 //! first and then what is left of the others', and the threads meet at a barrier after the
-//! per-particle pass and after the pair pass: two barriers per step. No float is ever summed in an order that depends on the thread count, the memory
-//! order of the particles, the skin or the cell size, so results are bitwise identical for all.
+//! per-particle pass and after the pair pass: two barriers per step. No float is ever summed in
+//! an order that depends on the thread count, the chunk a thread takes, the memory order of the
+//! particles, the skin or the cell size, so results are bitwise identical for all.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
@@ -136,7 +137,7 @@ struct Scratch {
     fill: Vec<u32>,
     /// Class and gap bin of each pair, `class · GAP_BINS + bin`, in build order.
     bin: Vec<u8>,
-    /// Build-order index of each pair, in the order of the shares' bins.
+    /// Build-order index of each pair, in the order of the chunks' bins.
     sorted: Vec<u32>,
     /// Threads of the step.
     threads: usize,
