@@ -191,9 +191,10 @@ impl WorkQueue {
 /// Binds the calling thread to one CPU while it lives, then gives it back the CPUs it had. A
 /// team left to the scheduler loses time when a thread is moved, or starts on its partner's
 /// CPU (each run spawns its threads anew): on the 2-vCPU CI machine, binding thread t to the
-/// t-th allowed CPU made 2 threads 15 % faster (median of 60 paired rounds of 5000 steps,
-/// faster in 45), and cut their barrier waits from 3.4 to 1.4 µs a step. Open MPI's `mpirun`
-/// binds ranks to cores the same way when it starts two or fewer.
+/// t-th allowed CPU made 2 threads 15 % and, in a second reading, 7 % faster (medians of 60
+/// paired rounds of 5000 steps, faster in 45 and 38), and cut their barrier waits from 3.4 to
+/// 1.4 µs a step. Open MPI's `mpirun` binds ranks to cores the same way when it starts two or
+/// fewer.
 pub struct Bound {
     previous: libc::cpu_set_t,
 }
