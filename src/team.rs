@@ -199,25 +199,37 @@ pub struct Bound {
     previous: libc::cpu_set_t,
 }
 
+/// The calling thread's affinity mask, if the kernel gives it.
+fn affinity() -> Option<libc::cpu_set_t> {
+    // SAFETY: a zeroed cpu_set_t is an empty set; the call writes at most its size.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        let size = std::mem::size_of::<libc::cpu_set_t>();
+        (libc::sched_getaffinity(0, size, &mut set) == 0).then_some(set)
+    }
+}
+
+/// The CPUs of `set`, in increasing order.
+fn cpus_of(set: &libc::cpu_set_t) -> impl Iterator<Item = usize> + '_ {
+    // SAFETY: CPU_ISSET reads the set within CPU_SETSIZE.
+    (0..libc::CPU_SETSIZE as usize).filter(move |&c| unsafe { libc::CPU_ISSET(c, set) })
+}
+
 impl Bound {
     /// Binds the calling thread to the `n`-th CPU (from 0) of its current affinity mask when
     /// `threads` threads fit on distinct CPUs of that mask; `None` (and nothing changed)
     /// otherwise.
     pub fn to_nth_cpu(n: usize, threads: usize) -> Option<Bound> {
-        let size = std::mem::size_of::<libc::cpu_set_t>();
-        // SAFETY: a zeroed cpu_set_t is an empty set; the calls read or write `size` bytes.
+        let previous = affinity()?;
+        if cpus_of(&previous).count() < threads {
+            return None;
+        }
+        let cpu = cpus_of(&previous).nth(n)?;
+        // SAFETY: a zeroed cpu_set_t is an empty set; the call reads `size` bytes of it.
         unsafe {
-            let mut previous: libc::cpu_set_t = std::mem::zeroed();
-            if libc::sched_getaffinity(0, size, &mut previous) != 0
-                || (libc::CPU_COUNT(&previous) as usize) < threads
-            {
-                return None;
-            }
-            let cpu = (0..libc::CPU_SETSIZE as usize)
-                .filter(|&c| libc::CPU_ISSET(c, &previous))
-                .nth(n)?;
             let mut one: libc::cpu_set_t = std::mem::zeroed();
             libc::CPU_SET(cpu, &mut one);
+            let size = std::mem::size_of::<libc::cpu_set_t>();
             (libc::sched_setaffinity(0, size, &one) == 0).then_some(Bound { previous })
         }
     }
@@ -368,14 +380,7 @@ mod tests {
 
     /// The CPUs the calling thread may run on.
     fn cpus() -> Vec<usize> {
-        let size = std::mem::size_of::<libc::cpu_set_t>();
-        unsafe {
-            let mut set: libc::cpu_set_t = std::mem::zeroed();
-            assert_eq!(libc::sched_getaffinity(0, size, &mut set), 0);
-            (0..libc::CPU_SETSIZE as usize)
-                .filter(|&c| libc::CPU_ISSET(c, &set))
-                .collect()
-        }
+        cpus_of(&affinity().expect("sched_getaffinity")).collect()
     }
 
     #[test]
