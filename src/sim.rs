@@ -185,8 +185,12 @@ const CLASSES: usize = 6;
 
 /// Chunks of each pass per thread when the team has more than one: enough that a thread done
 /// early takes over a small piece of its partner's work (the wait at a pass's end is at most
-/// about one chunk), few enough that handing them out costs nothing (one atomic operation each).
-const CHUNKS_PER_THREAD: usize = 16;
+/// about one chunk), few enough that starting chunks stays cheap. A chunk start costs about
+/// 70 ns (an atomic operation and a fresh loop over each of the chunk's arrays): 16 chunks on
+/// 1 thread ran 2.7 % and 4.9 % slower than one chunk (40 paired rounds each). On the 2-vCPU CI
+/// machine 8 per thread ran 4.1–5.9 % faster than 16 (three readings of 40–60 paired rounds,
+/// faster in 24–40 of them); 6 and 12 were within noise of 8.
+const CHUNKS_PER_THREAD: usize = 8;
 
 /// A free particle is fast, at a build, when its speed exceeds this fraction of the fastest
 /// free particle's.
