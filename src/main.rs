@@ -249,6 +249,9 @@ fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::sim::Engine>)>
         cell: common.cell,
     };
     let engine = engine::build(&case, scene, &o);
+    if let Some(warning) = verdem::team::oversubscribed(engine.core().threads) {
+        eprintln!("warning: {warning}");
+    }
     Ok((case, engine))
 }
 
@@ -394,6 +397,12 @@ fn real_main() -> anyhow::Result<()> {
         } => {
             let case =
                 Case::load(&case.unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml")))?;
+            for warning in threads
+                .iter()
+                .filter_map(|&t| verdem::team::oversubscribed(t))
+            {
+                eprintln!("warning: {warning}");
+            }
             let mut configs: Vec<bench::Config> = threads
                 .iter()
                 .map(|&t| bench::Config::Verdem {

@@ -135,3 +135,42 @@ fn reordered_force_summation_changes_the_hash() {
     };
     assert_ne!(kick(forward), kick(backward));
 }
+
+/// A team larger than the CPUs the process may use is warned about (it waits at every barrier
+/// for threads that are not running) and still gives the bits of one thread.
+#[test]
+fn a_team_larger_than_its_cpus_is_warned_about_and_keeps_the_bits() {
+    let state = shared("states/mercury_t143.85.data");
+    let case = root().join("cases/shear_flow_quick.toml");
+    // the first CPU this process may use, from e.g. "Cpus_allowed_list:\t0-1"
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    let allowed = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
+        .expect("Cpus_allowed_list");
+    let cpu: String = allowed
+        .trim()
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    let hash_on_one_cpu = |threads: &str| {
+        let out = std::process::Command::new("taskset")
+            .args(["-c", &cpu, env!("CARGO_BIN_EXE_verdem"), "hash"])
+            .args(["--steps", "50"])
+            .args(["--threads", threads, "--init"])
+            .args([&state, &case])
+            .output()
+            .expect("taskset (util-linux) runs");
+        assert!(out.status.success(), "{out:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        (String::from_utf8(out.stdout).unwrap(), err)
+    };
+    let (one, quiet) = hash_on_one_cpu("1");
+    let (two, warned) = hash_on_one_cpu("2");
+    assert!(!quiet.contains("warning"), "{quiet}");
+    assert!(
+        warned.contains("warning: 2 threads, but this process may run on 1 CPU(s)"),
+        "{warned}"
+    );
+    assert_eq!(one, two);
+}
