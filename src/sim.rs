@@ -14,10 +14,15 @@
 //! Steps 4 of one step and 1 of the next touch only one particle each, so they run fused in one
 //! pass. With T threads every thread runs this loop; each pass is cut into chunks (contiguous
 //! particles, contiguous pairs) that the threads take from a [`WorkQueue`], their own share
-//! first and then what is left of the others', and the threads meet at a barrier after the
-//! per-particle pass and after the pair pass: two barriers per step. No float is ever summed in
-//! an order that depends on the thread count, the chunk a thread takes, the memory order of the
-//! particles, the skin or the cell size, so results are bitwise identical for all.
+//! first and then what is left of the others'. The threads meet at one barrier per step, after
+//! the per-particle pass (every thread needs every particle's new position and the largest
+//! speeds, which decide a rebuild). After the pair pass there is none: a thread done with the
+//! pair chunks goes on to the particle chunks, and each particle chunk waits only for the pair
+//! chunks that hold its particles' pairs, marked done chunk by chunk ([`Marks`]), so the
+//! threads' ends of the pair pass overlap their partner's work instead of waiting for it. No
+//! float is ever summed in an order that depends on the thread count, the chunk a thread takes,
+//! the memory order of the particles, the skin or the cell size, so results are bitwise
+//! identical for all.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
@@ -26,7 +31,7 @@ use crate::contact::{ContactLaw, PairForce, PairInput};
 use crate::domain::Domain;
 use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::{Motion, Particles};
-use crate::team::{balanced_ranges, Bound, Shared, SpinBarrier, WorkQueue};
+use crate::team::{balanced_ranges, Bound, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 
 /// Wall-clock time spent in each stage, in nanoseconds, measured on thread 0.
@@ -38,10 +43,20 @@ pub struct StageTimes {
     pub forces: u64,
     /// Gather of pair forces, kicks and drifts (per-particle pass).
     pub integrate: u64,
-    /// Waiting for the other threads at barriers.
+    /// Waiting for the other threads: at barriers, and for the pair chunks a gather needs.
     pub wait: u64,
     /// Number of pair-list rebuilds.
     pub rebuilds: u64,
+}
+
+impl StageTimes {
+    /// Moves `waited` ns, spent inside the particle pass waiting for pair chunks, from
+    /// `integrate` to `wait`.
+    fn count_wait_in_integrate(&mut self, waited: u64) {
+        let waited = waited.min(self.integrate);
+        self.integrate -= waited;
+        self.wait += waited;
+    }
 }
 
 /// One contact of a [`Snapshot`], by original particle indices `p < i`.
@@ -153,6 +168,11 @@ struct Scratch {
     /// Gap |r| − (r_P + r_I) of each pair at the build, rounded down to a sixteenth of the skin
     /// (length).
     gap: Vec<f64>,
+    /// Lowest and one past the highest memory index of a particle of each pair chunk's pairs.
+    pair_hull: Vec<(u32, u32)>,
+    /// The pair chunks a particle chunk's gather waits for: every chunk with a pair of its
+    /// particles is in this range of chunk indices (which may hold others).
+    needs: Vec<(u32, u32)>,
 }
 
 impl Scratch {
@@ -437,12 +457,15 @@ impl<L: ContactLaw> Simulation<L> {
         let core = &mut self.core;
         let threads = core.threads;
         let barrier = SpinBarrier::new(threads);
-        let vmax2: Vec<[AtomicU64; 2]> = (0..threads)
-            .map(|_| [AtomicU64::new(0), AtomicU64::new(0)])
+        // Each thread's largest squared speeds by kind, for even and odd steps: a thread may
+        // write the next step's while another still reads this one's.
+        let vmax2: Vec<[[AtomicU64; 2]; 2]> = (0..threads)
+            .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
             .collect();
         let chunks = core.scratch.chunks();
         let particle_queue = WorkQueue::new(threads, chunks);
         let pair_queue = WorkQueue::new(threads, chunks);
+        let pairs_done = Marks::new(chunks);
         let rebuild_queue = WorkQueue::new(threads, chunks);
         let bind = core.bind && threads > 1;
         let skin = core.skin();
@@ -476,40 +499,59 @@ impl<L: ContactLaw> Simulation<L> {
                     clock = now;
                 }
             };
-            // The particle pass over the chunks this thread takes; the largest squared speeds.
-            let particles = |kick_end: bool, drift: bool| {
+            // The particle pass over the chunks this thread takes, gathering the forces of step
+            // `gather` (none on the first step of a run) once every pair chunk with a pair of
+            // the chunk's particles is done; the largest squared speeds.
+            let particles = |gather: Option<u64>, drift: bool| {
                 let mut v2 = [0.0f64; 2];
+                let mut waited = 0;
                 while let Some(c) = particle_queue.next(tid) {
-                    // SAFETY: a chunk is run by one thread; see the loop below.
+                    // SAFETY: a chunk is run by one thread, and its pairs' outputs are final
+                    // (their chunks are marked done); see the loop below.
                     let seen = unsafe {
                         let l = list.get();
                         let (a, b) = l.scratch.particle_chunks[c];
-                        particle_pass::<L, ROT, GRAV>(&view, l, a, b, kick_end, drift)
+                        if let (Some(round), true) = (gather, threads > 1) {
+                            let (first, end) = l.scratch.needs[c];
+                            let w = pairs_done.wait(first as usize..end as usize, round);
+                            waited += w.as_nanos() as u64;
+                        }
+                        particle_pass::<L, ROT, GRAV>(&view, l, a, b, gather.is_some(), drift)
                     };
                     for (m, s) in v2.iter_mut().zip(seen) {
                         *m = m.max(s);
                     }
                 }
-                v2
+                (v2, waited)
             };
             let mut bound = bound0;
             for s in 0..steps {
-                // SAFETY (all blocks below): phases are separated by barriers; in each phase a
-                // thread writes only the particles or pairs of the chunks it takes, and a
-                // rebuild's serial phases run on thread 0 alone between two barriers.
-                let v2 = particles(s > 0, true);
-                for (slot, v) in vmax2[tid].iter().zip(v2) {
+                // SAFETY (all blocks below): the particle pass and the rebuild are separated from
+                // everything else by barriers; the pair pass of a step and the particle pass
+                // that gathers its forces are separated, chunk by chunk, by the pair chunks'
+                // marks; in each phase a thread writes only the particles or pairs of the chunks
+                // it takes, and a rebuild's serial phases run on thread 0 alone between two
+                // barriers.
+                let (v2, waited) = particles((s > 0).then_some(s), true);
+                let parity = (s % 2) as usize;
+                for (slot, v) in vmax2[tid][parity].iter().zip(v2) {
                     slot.store(v.to_bits(), Ordering::Relaxed);
                 }
                 lap(&mut local.integrate);
+                local.count_wait_in_integrate(waited);
                 barrier.wait();
                 lap(&mut local.wait);
+                // A home is refilled only once its last pass is over (no thread takes from an
+                // emptied home); the pair queue starts full for the first step.
                 particle_queue.refill(tid);
+                if s > 0 {
+                    pair_queue.refill(tid);
+                }
                 // Every thread derives the same bounds from the same numbers.
                 for (kind, b) in bound.iter_mut().enumerate() {
                     let m = vmax2
                         .iter()
-                        .map(|a| f64::from_bits(a[kind].load(Ordering::Relaxed)))
+                        .map(|a| f64::from_bits(a[parity][kind].load(Ordering::Relaxed)))
                         .fold(0.0, f64::max);
                     *b += m.sqrt() * view.dt;
                 }
@@ -552,14 +594,13 @@ impl<L: ContactLaw> Simulation<L> {
                             }
                         }
                     }
+                    pairs_done.set(c, s + 1);
                 }
                 lap(&mut local.forces);
-                barrier.wait();
-                lap(&mut local.wait);
-                pair_queue.refill(tid);
             }
-            particles(true, false);
+            let (_, waited) = particles(Some(steps), false);
             lap(&mut local.integrate);
+            local.count_wait_in_integrate(waited);
             (local, bound)
         };
         let (local, bound) = if threads == 1 {
@@ -752,6 +793,13 @@ impl ListState<'_> {
             let s = &mut *self.scratch;
             std::mem::swap(&mut self.pairs.p, &mut s.next_p);
             std::mem::swap(&mut self.pairs.i, &mut s.next_i);
+            for (needs, &(a, b)) in s.needs.iter_mut().zip(&s.particle_chunks) {
+                let hull = &s.pair_hull;
+                let touches = |j: &usize| (hull[*j].0 as usize) < b && (hull[*j].1 as usize) > a;
+                let first = (0..chunks).find(touches).unwrap_or(0);
+                let end = (0..chunks).rev().find(touches).map_or(first, |j| j + 1);
+                *needs = (first as u32, end as u32);
+            }
             self.pairs.index(n, self.id, &mut s.fill);
             s.reset_live();
             self.times.neighbor += t0.elapsed().as_nanos() as u64;
@@ -802,6 +850,8 @@ impl ListState<'_> {
         s.next_p.resize(n_pairs, 0);
         s.next_i.resize(n_pairs, 0);
         s.pair_ranges.resize(chunks, [0; CLASSES + 1]);
+        s.pair_hull.resize(chunks, (0, 0));
+        s.needs.resize(chunks, (0, 0));
         s.live.resize(chunks, [0; CLASSES]);
         self.xi.clear();
         self.xi.resize(n_pairs, Vec3::zeros());
@@ -864,11 +914,15 @@ impl ListState<'_> {
             s.sorted[*slot] = k as u32;
             *slot += 1;
         }
+        let mut hull = (u32::MAX, 0);
         for k in pa..pb {
             let from = s.sorted[k] as usize;
-            s.next_p[k] = self.pairs.p[from];
-            s.next_i[k] = self.pairs.i[from];
+            let (p, i) = (self.pairs.p[from], self.pairs.i[from]);
+            s.next_p[k] = p;
+            s.next_i[k] = i;
+            hull = (hull.0.min(p).min(i), hull.1.max(p + 1).max(i + 1));
         }
+        s.pair_hull[part] = hull;
         if s.old_keys.is_empty() {
             return;
         }
@@ -896,7 +950,9 @@ impl ListState<'_> {
 /// fast [1] particle (speed classes of the last build).
 ///
 /// # Safety
-/// Writes particles `a..b` only; reads pair outputs, which no one writes in this phase.
+/// Writes particles `a..b` only; with `kick_end`, call it only once every pair chunk holding a
+/// pair of these particles is done: it reads those pairs' outputs, and the pair chunks read the
+/// particles it writes.
 #[inline(never)]
 unsafe fn particle_pass<L, const ROT: bool, const GRAV: bool>(
     view: &StepView<'_, L>,
@@ -1042,7 +1098,8 @@ fn gather(a: usize, pairs: &PairList, active: &[bool], out: &[PairForce]) -> (Ve
 /// is their minimum image.
 ///
 /// # Safety
-/// Writes the slots of pairs `a..b` only; reads particles, which no one writes in this phase.
+/// Writes the slots of pairs `a..b` and the `touched` flags of their particles only; reads
+/// particles, which no one writes before the pairs' chunk is marked done.
 #[inline(never)]
 unsafe fn pair_pass<L: ContactLaw, const PERIODIC: bool>(
     view: &StepView<'_, L>,

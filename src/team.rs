@@ -143,8 +143,11 @@ impl WorkQueue {
         )
     }
 
-    /// Restores thread `tid`'s home for the next pass. Only its owner calls this, between the
-    /// barrier that ends a pass and the barrier before the queue's next pass.
+    /// Restores thread `tid`'s home for the next pass. Only its owner calls this, once every
+    /// thread is done taking chunks of the queue's last pass (after a barrier that follows that
+    /// pass) and before its own next pass. A thread that looks at this home before it is
+    /// refilled finds it empty and leaves its chunks to the owner; a home that is not empty
+    /// (a queue that has not run a pass yet) must not be refilled.
     pub fn refill(&self, tid: usize) {
         let (lo, hi) = self.home(tid);
         self.left[tid].0.store(pack(lo, hi), Ordering::Relaxed);
@@ -185,6 +188,51 @@ impl WorkQueue {
                 Err(seen) => cur = seen,
             }
         }
+    }
+}
+
+/// Completion marks of the chunks of a pass: a thread marks each chunk it finishes with the
+/// round (step) it finished it for, and a thread that needs a chunk's outputs waits for its mark
+/// instead of for the whole team at a barrier.
+pub struct Marks {
+    marks: Vec<Padded>,
+}
+
+impl Marks {
+    /// `chunks` marks, all at round 0.
+    pub fn new(chunks: usize) -> Self {
+        Marks {
+            marks: (0..chunks).map(|_| Padded(AtomicU64::new(0))).collect(),
+        }
+    }
+
+    /// Marks chunk `chunk` done for `round`; its outputs are published to [`Marks::wait`].
+    #[inline]
+    pub fn set(&self, chunk: usize, round: u64) {
+        self.marks[chunk].0.store(round, Ordering::Release);
+    }
+
+    /// Returns once every chunk of `chunks` is marked done for `round` or a later one, with the
+    /// time it waited (zero, unmeasured, when nothing was left to wait for). Spins for up to
+    /// [`SPIN`], then yields its core between checks (a mark has no sleepers to wake: its chunk
+    /// is already being run).
+    #[inline]
+    pub fn wait(&self, chunks: std::ops::Range<usize>, round: u64) -> Duration {
+        let done = |c: usize| self.marks[c].0.load(Ordering::Acquire) >= round;
+        if chunks.clone().all(done) {
+            return Duration::ZERO;
+        }
+        let start = Instant::now();
+        let mut spins = 0u32;
+        while !chunks.clone().all(done) {
+            spins = spins.wrapping_add(1);
+            if spins.is_multiple_of(64) && start.elapsed() > SPIN {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        }
+        start.elapsed()
     }
 }
 
@@ -415,6 +463,33 @@ mod tests {
         })
         .join()
         .unwrap();
+    }
+
+    #[test]
+    fn a_wait_on_marks_returns_once_every_chunk_is_marked_and_sees_its_writes() {
+        let marks = Marks::new(4);
+        marks.set(1, 7);
+        assert_eq!(marks.wait(1..2, 7), Duration::ZERO, "already marked");
+        assert_eq!(marks.wait(0..0, 9), Duration::ZERO, "nothing to wait for");
+        let written = AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                for c in [0, 2, 1] {
+                    std::thread::sleep(Duration::from_millis(20));
+                    written.fetch_add(1, Ordering::Relaxed);
+                    marks.set(c, 8);
+                }
+            });
+            let waited = marks.wait(0..3, 8);
+            assert_eq!(
+                written.load(Ordering::Relaxed),
+                3,
+                "returned before the last mark"
+            );
+            assert!(waited >= Duration::from_millis(50), "{waited:?}");
+        });
+        // a chunk marked for a later round is done for an earlier one
+        assert_eq!(marks.wait(0..3, 5), Duration::ZERO);
     }
 
     #[test]
