@@ -209,7 +209,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             let total = (st.neighbor + st.forces + st.integrate + st.wait).max(1) as f64;
             let pct = |v: u64| 100.0 * v as f64 / total;
             s.push_str(&format!(
-                "\nverdem, {threads} thread(s), last round, thread 0: neighbour list {:.1} % ({} rebuilds), pair forces {:.1} %, gather + integration {:.1} %, barrier waits {:.1} %; output 0 % (none in the timed region)\n",
+                "\nverdem, {threads} thread(s), last round, thread 0: neighbour list {:.1} % ({} rebuilds), pair forces {:.1} %, gather + integration {:.1} %, waiting for the other threads {:.1} %; output 0 % (none in the timed region)\n",
                 pct(st.neighbor),
                 st.rebuilds,
                 pct(st.forces),
