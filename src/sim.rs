@@ -209,7 +209,9 @@ const CLASSES: usize = 6;
 /// 70 ns (an atomic operation and a fresh loop over each of the chunk's arrays): 16 chunks on
 /// 1 thread ran 2.7 % and 4.9 % slower than one chunk (40 paired rounds each). On the 2-vCPU CI
 /// machine 8 per thread ran 4.1–5.9 % faster than 16 (three readings of 40–60 paired rounds,
-/// faster in 24–40 of them); 6 and 12 were within noise of 8.
+/// faster in 24–40 of them); 6 and 12 were within noise of 8. Without the barrier after the
+/// pair pass, 4, 5 and 6 per thread were within 2.2 % of 8 either way and 12 was 5.4 % slower
+/// (40 paired rounds each).
 const CHUNKS_PER_THREAD: usize = 8;
 
 /// A free particle is fast, at a build, when its speed exceeds this fraction of the fastest
