@@ -308,12 +308,13 @@ pub fn oversubscribed(threads: usize) -> Option<String> {
 }
 
 /// A value shared by the team whose parts are written by one thread at a time, as arranged by
-/// the step's phases and barriers (each thread writes only its own index range between two
-/// barriers; reads of data written by others happen only after a barrier).
+/// the step's phases, barriers and marks (each thread writes only its own index range between
+/// two barriers; reads of data written by others happen only after a barrier, or after the
+/// [`Marks`] of the chunks that wrote them).
 pub struct Shared<T>(UnsafeCell<T>);
 
-// SAFETY: access is coordinated by the phase structure described above; the barrier's
-// acquire/release orderings publish each phase's writes to the next phase.
+// SAFETY: access is coordinated by the phase structure described above; the acquire/release
+// orderings of the barrier and of the marks publish each phase's writes to the next phase.
 unsafe impl<T: Send> Sync for Shared<T> {}
 
 impl<T> Shared<T> {
