@@ -182,7 +182,8 @@ impl WorkQueue {
                 (pack(lo, hi - 1), hi - 1)
             };
             // Relaxed: the chunk's inputs and outputs are published by the barriers around the
-            // pass; this only decides who runs it, and every update of `slot` is one atomic step.
+            // pass or by the chunks' marks; this only decides who runs it, and every update of
+            // `slot` is one atomic step.
             match slot.compare_exchange_weak(cur, next, Ordering::Relaxed, Ordering::Relaxed) {
                 Ok(_) => return Some(chunk),
                 Err(seen) => cur = seen,
@@ -215,7 +216,7 @@ impl Marks {
     /// Returns once every chunk of `chunks` is marked done for `round` or a later one, with the
     /// time it waited (zero, unmeasured, when nothing was left to wait for). Spins for up to
     /// [`SPIN`], then yields its core between checks (a mark has no sleepers to wake: its chunk
-    /// is already being run).
+    /// is run by a thread that is not waiting on marks).
     #[inline]
     pub fn wait(&self, chunks: std::ops::Range<usize>, round: u64) -> Duration {
         let done = |c: usize| self.marks[c].0.load(Ordering::Acquire) >= round;
@@ -234,6 +235,12 @@ impl Marks {
         }
         start.elapsed()
     }
+}
+
+/// The CPUs the calling thread may run on, in increasing order (empty if the kernel does not
+/// say).
+pub fn allowed_cpus() -> Vec<usize> {
+    affinity().map_or_else(Vec::new, |set| cpus_of(&set).collect())
 }
 
 /// Binds the calling thread to one CPU while it lives, then gives it back the CPUs it had. A
@@ -443,24 +450,20 @@ mod tests {
         }
     }
 
-    /// The CPUs the calling thread may run on.
-    fn cpus() -> Vec<usize> {
-        cpus_of(&affinity().expect("sched_getaffinity")).collect()
-    }
-
     #[test]
     fn a_bound_thread_runs_on_its_cpu_and_gets_its_cpus_back() {
         std::thread::spawn(|| {
-            let before = cpus();
+            let before = allowed_cpus();
+            assert!(!before.is_empty(), "sched_getaffinity");
             let n = before.len() - 1;
             {
                 let _bound = Bound::to_nth_cpu(n, before.len()).expect("binding failed");
-                assert_eq!(cpus(), [before[n]]);
+                assert_eq!(allowed_cpus(), [before[n]]);
             }
-            assert_eq!(cpus(), before);
+            assert_eq!(allowed_cpus(), before);
             // more threads than CPUs: left alone
             assert!(Bound::to_nth_cpu(0, before.len() + 1).is_none());
-            assert_eq!(cpus(), before);
+            assert_eq!(allowed_cpus(), before);
         })
         .join()
         .unwrap();

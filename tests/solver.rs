@@ -142,17 +142,10 @@ fn reordered_force_summation_changes_the_hash() {
 fn a_team_larger_than_its_cpus_is_warned_about_and_keeps_the_bits() {
     let state = shared("states/mercury_t143.85.data");
     let case = root().join("cases/shear_flow_quick.toml");
-    // the first CPU this process may use, from e.g. "Cpus_allowed_list:\t0-1"
-    let status = std::fs::read_to_string("/proc/self/status").unwrap();
-    let allowed = status
-        .lines()
-        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
-        .expect("Cpus_allowed_list");
-    let cpu: String = allowed
-        .trim()
-        .chars()
-        .take_while(char::is_ascii_digit)
-        .collect();
+    let cpu = verdem::team::allowed_cpus()
+        .first()
+        .expect("sched_getaffinity")
+        .to_string();
     let hash_on_one_cpu = |threads: &str| {
         let out = std::process::Command::new("taskset")
             .args(["-c", &cpu, env!("CARGO_BIN_EXE_verdem"), "hash"])
