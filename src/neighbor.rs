@@ -45,8 +45,11 @@ pub struct NeighborBuilder {
     /// Edge of a cell; ≥ 2 r_max + skin (length).
     pub cell: f64,
     pub search: Search,
-    keys: Vec<(u32, u32)>,
+    /// Cell of each particle at the last [`NeighborBuilder::order`] or `prepare`.
+    cells: Vec<u32>,
     cell_start: Vec<u32>,
+    /// Scratch of the counting sort.
+    fill: Vec<u32>,
     /// Half stencils of the grid they were made for, as runs of consecutive cells: the cells
     /// `stencil[j].0..stencil[j].1` for `j` in `stencil_start[c]..stencil_start[c + 1]` are
     /// the distinct cells adjacent to (or equal to) cell `c`, less the runs that lie wholly
@@ -65,8 +68,9 @@ impl NeighborBuilder {
             skin,
             cell: cell.max(2.0 * r_max + skin),
             search,
-            keys: Vec::new(),
+            cells: Vec::new(),
             cell_start: Vec::new(),
+            fill: Vec::new(),
             stencil: Vec::new(),
             stencil_start: Vec::new(),
             stencil_grid: None,
@@ -74,17 +78,29 @@ impl NeighborBuilder {
     }
 
     /// The memory order for positions `x`: indices sorted by (cell, id), cells in the grid's
-    /// axis order (a walled axis slowest).
-    /// `order[new] = old`.
+    /// axis order (a walled axis slowest). `order[new] = old`. It also prepares the builder for
+    /// the positions in that order, as [`NeighborBuilder::prepare`] would once the caller has
+    /// re-ordered them, so that [`NeighborBuilder::search`] may follow.
     pub fn order(&mut self, domain: &Domain, x: &[Vec3], id: &[u32], order: &mut Vec<u32>) {
         let grid = Grid::new(domain, self.cell);
-        self.keys.clear();
-        self.keys
-            .extend((0..x.len()).map(|a| (grid.index(grid.coords(domain, &x[a])) as u32, id[a])));
+        self.count_cells(&grid, domain, x);
+        // A counting sort by cell, then each cell's few particles by id.
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.cell_start);
         order.clear();
-        order.extend(0..x.len() as u32);
-        let keys = &self.keys;
-        order.sort_unstable_by_key(|&a| keys[a as usize]);
+        order.resize(x.len(), 0);
+        for (a, &c) in self.cells.iter().enumerate() {
+            let at = &mut self.fill[c as usize];
+            order[*at as usize] = a as u32;
+            *at += 1;
+        }
+        for run in self.cell_start.windows(2) {
+            let cell = &mut order[run[0] as usize..run[1] as usize];
+            if cell.len() > 1 {
+                cell.sort_unstable_by_key(|&a| id[a as usize]);
+            }
+        }
+        self.make_stencils(&grid);
     }
 
     /// Rebuilds the pairs of `list` for particles already in [`NeighborBuilder::order`]'s
@@ -115,16 +131,24 @@ impl NeighborBuilder {
             return;
         }
         let grid = Grid::new(domain, self.cell);
-        // Particles are sorted by cell: each cell is a contiguous range.
+        self.count_cells(&grid, domain, x);
+        self.make_stencils(&grid);
+    }
+
+    /// The cell of each particle, and `cell_start`: the particles of cell `c`, once sorted by
+    /// cell, are `cell_start[c]..cell_start[c + 1]`.
+    fn count_cells(&mut self, grid: &Grid, domain: &Domain, x: &[Vec3]) {
+        self.cells.clear();
+        self.cells
+            .extend(x.iter().map(|p| grid.index(grid.coords(domain, p)) as u32));
         self.cell_start.clear();
         self.cell_start.resize(grid.count() + 1, 0);
-        for p in x {
-            self.cell_start[grid.index(grid.coords(domain, p)) + 1] += 1;
+        for &c in &self.cells {
+            self.cell_start[c as usize + 1] += 1;
         }
         for c in 0..grid.count() {
             self.cell_start[c + 1] += self.cell_start[c];
         }
-        self.make_stencils(&grid);
     }
 
     /// Appends to `found` (P, I memory indices) the pairs owned by the particles `owners`, the
@@ -470,6 +494,35 @@ mod tests {
                 b.search(&domain, &xs, &r, &ids, owners, |_, _| true, (&mut p, &mut i));
             }
             proptest::prop_assert_eq!((p, i), (cells.p, cells.i));
+        }
+    }
+
+    proptest::proptest! {
+        /// The counting sort gives the order by (cell, id) whatever the ids, and leaves the
+        /// builder ready to search the re-ordered positions: the same pairs as a full build.
+        #[test]
+        fn order_sorts_by_cell_then_id_and_prepares_the_search(
+            n in 1usize..300,
+            seed in 0u64..1000,
+            skin in 0.05f64..0.6,
+        ) {
+            let (domain, x, r, _) = random_scene(n, seed);
+            let id: Vec<u32> = (0..n as u32).map(|a| (a * 7919) % n as u32).collect();
+            let mut b = NeighborBuilder::new(skin, 0.0, 0.5, Search::Cells);
+            let mut order = Vec::new();
+            b.order(&domain, &x, &id, &mut order);
+            let grid = Grid::new(&domain, b.cell);
+            let key = |a: usize| (grid.index(grid.coords(&domain, &x[a])), id[a]);
+            let mut expected: Vec<u32> = (0..n as u32).collect();
+            expected.sort_by_key(|&a| key(a as usize));
+            proptest::prop_assert_eq!(&order, &expected);
+            let xs: Vec<Vec3> = order.iter().map(|&o| x[o as usize]).collect();
+            let ids: Vec<u32> = order.iter().map(|&o| id[o as usize]).collect();
+            let (mut p, mut i) = (Vec::new(), Vec::new());
+            b.search(&domain, &xs, &r, &ids, 0..n, |_, _| true, (&mut p, &mut i));
+            let mut built = PairList::default();
+            b.build(&mut built, &domain, &xs, &r, &ids, |_, _| true);
+            proptest::prop_assert_eq!((p, i), (built.p, built.i));
         }
     }
 

@@ -734,7 +734,8 @@ impl ListState<'_> {
             }
             s.old_keys.sort_unstable();
             std::mem::swap(&mut s.old_xi, self.xi);
-            // Memory order by cell.
+            // Memory order by cell; the builder is then ready to search the re-ordered
+            // particles.
             self.builder.order(domain, &pt.x, self.id, &mut s.order);
             if s.next.len() != n {
                 // room only: every element is written below
@@ -761,7 +762,6 @@ impl ListState<'_> {
         if crew.leads() {
             std::mem::swap(pt, &mut s.next);
             std::mem::swap(self.id, &mut s.next_id);
-            self.builder.prepare(domain, &pt.x);
         }
         crew.sync();
         crew.share(chunks, |part| {
@@ -855,9 +855,8 @@ impl ListState<'_> {
         s.pair_hull.resize(chunks, (0, 0));
         s.needs.resize(chunks, (0, 0));
         s.live.resize(chunks, [0; CLASSES]);
-        self.xi.clear();
+        // Room only: each chunk clears its pairs' history in `sort_chunk`.
         self.xi.resize(n_pairs, Vec3::zeros());
-        self.active.clear();
         self.active.resize(n_pairs, false);
         self.out.resize(n_pairs, PairForce::default());
     }
@@ -925,6 +924,8 @@ impl ListState<'_> {
             hull = (hull.0.min(p).min(i), hull.1.max(p + 1).max(i + 1));
         }
         s.pair_hull[part] = hull;
+        self.xi[pa..pb].fill(Vec3::zeros());
+        self.active[pa..pb].fill(false);
         if s.old_keys.is_empty() {
             return;
         }
