@@ -883,8 +883,11 @@ impl ListState<'_> {
                 && r == direct
                 && (0..3).all(|k| !domain.periodic[k] || cut + skin < 0.5 * domain.lengths()[k]);
             let gap = r.norm() - (pt.radius[p] + pt.radius[i]);
-            let bin = if skin > 0.0 {
-                ((gap / bin_width).floor() + 1.0).clamp(0.0, (GAP_BINS - 1) as f64) as usize
+            // floor(gap / width) + 1, clamped to the bins; the cast floors a non-negative
+            // quotient without a call to libm's floor.
+            let q = gap / bin_width;
+            let bin = if skin > 0.0 && q >= 0.0 {
+                (q as usize).min(GAP_BINS - 2) + 1
             } else {
                 0
             };
