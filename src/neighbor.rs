@@ -48,7 +48,8 @@ pub struct NeighborBuilder {
     /// Cell of each particle at the last [`NeighborBuilder::order`] or `prepare`.
     cells: Vec<u32>,
     cell_start: Vec<u32>,
-    /// Scratch of the counting sort.
+    /// Scratch of the counting sort: the memory index of each id, and each cell's next slot.
+    by_id: Vec<u32>,
     fill: Vec<u32>,
     /// Half stencils of the grid they were made for, as runs of consecutive cells: the cells
     /// `stencil[j].0..stencil[j].1` for `j` in `stencil_start[c]..stencil_start[c + 1]` are
@@ -70,6 +71,7 @@ impl NeighborBuilder {
             search,
             cells: Vec::new(),
             cell_start: Vec::new(),
+            by_id: Vec::new(),
             fill: Vec::new(),
             stencil: Vec::new(),
             stencil_start: Vec::new(),
@@ -77,28 +79,29 @@ impl NeighborBuilder {
         }
     }
 
-    /// The memory order for positions `x`: indices sorted by (cell, id), cells in the grid's
-    /// axis order (a walled axis slowest). `order[new] = old`. It also prepares the builder for
+    /// The memory order for positions `x` with original indices `id` (a permutation of
+    /// `0..x.len()`): indices sorted by (cell, id), cells in the grid's axis order (a walled axis
+    /// slowest). `order[new] = old`. It also prepares the builder for
     /// the positions in that order, as [`NeighborBuilder::prepare`] would once the caller has
     /// re-ordered them, so that [`NeighborBuilder::search`] may follow.
     pub fn order(&mut self, domain: &Domain, x: &[Vec3], id: &[u32], order: &mut Vec<u32>) {
         let grid = Grid::new(domain, self.cell);
         self.count_cells(&grid, domain, x);
-        // A counting sort by cell, then each cell's few particles by id.
+        // A counting sort by cell, stable, over the particles taken in id order: each cell's
+        // particles come out by id.
+        self.by_id.clear();
+        self.by_id.resize(x.len(), 0);
+        for (a, &i) in id.iter().enumerate() {
+            self.by_id[i as usize] = a as u32;
+        }
         self.fill.clear();
         self.fill.extend_from_slice(&self.cell_start);
         order.clear();
         order.resize(x.len(), 0);
-        for (a, &c) in self.cells.iter().enumerate() {
-            let at = &mut self.fill[c as usize];
-            order[*at as usize] = a as u32;
+        for &a in &self.by_id {
+            let at = &mut self.fill[self.cells[a as usize] as usize];
+            order[*at as usize] = a;
             *at += 1;
-        }
-        for run in self.cell_start.windows(2) {
-            let cell = &mut order[run[0] as usize..run[1] as usize];
-            if cell.len() > 1 {
-                cell.sort_unstable_by_key(|&a| id[a as usize]);
-            }
         }
         self.make_stencils(&grid);
     }
