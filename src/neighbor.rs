@@ -81,9 +81,9 @@ impl NeighborBuilder {
 
     /// The memory order for positions `x` with original indices `id` (a permutation of
     /// `0..x.len()`): indices sorted by (cell, id), cells in the grid's axis order (a walled axis
-    /// slowest). `order[new] = old`. It also prepares the builder for
-    /// the positions in that order, as [`NeighborBuilder::prepare`] would once the caller has
-    /// re-ordered them, so that [`NeighborBuilder::search`] may follow.
+    /// slowest). `order[new] = old`. It also prepares the builder for the positions in that
+    /// order, as [`NeighborBuilder::prepare`] would once the caller has re-ordered them, so that
+    /// [`NeighborBuilder::search`] may follow.
     pub fn order(&mut self, domain: &Domain, x: &[Vec3], id: &[u32], order: &mut Vec<u32>) {
         let grid = Grid::new(domain, self.cell);
         self.count_cells(&grid, domain, x);
