@@ -588,13 +588,7 @@ impl<L: ContactLaw> Simulation<L> {
                             }
                         }
                         let ends = *ends;
-                        for class in 0..CLASSES {
-                            if class < CLASSES / 2 {
-                                pair_pass::<L, false>(&view, l, seg[class], ends[class]);
-                            } else {
-                                pair_pass::<L, true>(&view, l, seg[class], ends[class]);
-                            }
-                        }
+                        pair_chunk(&view, l, &seg, &ends);
                     }
                     pairs_done.set(c, s + 1);
                 }
@@ -1100,39 +1094,78 @@ fn gather(a: usize, pairs: &PairList, active: &[bool], out: &[PairForce]) -> (Ve
     (f, t)
 }
 
-/// Pair pass over pairs `a..b`; `PERIODIC` false for interior pairs, whose direct separation
-/// is their minimum image.
+/// Pair pass over one chunk: the live prefix `seg[c]..ends[c]` of each class `c`. The first
+/// `CLASSES / 2` classes hold interior pairs, whose direct separation is their minimum image.
+/// One call per chunk rather than per class: with 16 chunks on 1 thread, 464.5 k instructions
+/// a step against 466.2 k (valgrind's callgrind, steps 2000 to 4000 from `mercury_t143.85`).
 ///
 /// # Safety
-/// Writes the slots of pairs `a..b` and the `touched` flags of their particles only; reads
-/// particles, which no one writes before the pairs' chunk is marked done.
+/// Writes the slots of these pairs and the `touched` flags of their particles only; reads
+/// particles, which no one writes before the chunk is marked done.
 #[inline(never)]
-unsafe fn pair_pass<L: ContactLaw, const PERIODIC: bool>(
+unsafe fn pair_chunk<L: ContactLaw>(
     view: &StepView<'_, L>,
     l: &mut ListState<'_>,
-    a: usize,
-    b: usize,
+    seg: &[usize; CLASSES + 1],
+    ends: &[usize; CLASSES],
 ) {
-    let pt = view.particles.get();
     // Plain slices: their bounds live in registers for the whole loop.
-    let parts = ParticleSlices::of(pt);
-    let (pp, ii) = (&l.pairs.p[a..b], &l.pairs.i[a..b]);
-    let (xi, active, out) = (&mut l.xi[a..b], &mut l.active[a..b], &mut l.out[a..b]);
+    let parts = ParticleSlices::of(view.particles.get());
     let touched = &l.touched[..];
-    for k in 0..pp.len() {
-        let (p, i) = (pp[k] as usize, ii[k] as usize);
+    let (p, i) = (&l.pairs.p[..], &l.pairs.i[..]);
+    let (xi, active, out) = (&mut l.xi[..], &mut l.active[..], &mut l.out[..]);
+    for class in 0..CLASSES {
+        let (a, b) = (seg[class], ends[class]);
+        if a == b {
+            continue;
+        }
+        let slots = PairSlots {
+            p: &p[a..b],
+            i: &i[a..b],
+            xi: &mut xi[a..b],
+            active: &mut active[a..b],
+            out: &mut out[a..b],
+        };
+        if class < CLASSES / 2 {
+            pair_range::<L, false>(view, &parts, touched, slots);
+        } else {
+            pair_range::<L, true>(view, &parts, touched, slots);
+        }
+    }
+}
+
+/// A range of pairs and their slots.
+struct PairSlots<'a> {
+    p: &'a [u32],
+    i: &'a [u32],
+    xi: &'a mut [Vec3],
+    active: &'a mut [bool],
+    out: &'a mut [PairForce],
+}
+
+/// Forces of a range of pairs into their slots; sets the `touched` flag of the free particles
+/// of every contact. `PERIODIC` false for interior pairs.
+#[inline(always)]
+fn pair_range<L: ContactLaw, const PERIODIC: bool>(
+    view: &StepView<'_, L>,
+    parts: &ParticleSlices<'_>,
+    touched: &[AtomicBool],
+    s: PairSlots<'_>,
+) {
+    for k in 0..s.p.len() {
+        let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         pair_force::<L, PERIODIC>(
             view.law,
             view.domain,
             view.dt,
             p,
             i,
-            &parts,
-            &mut xi[k],
-            &mut active[k],
-            &mut out[k],
+            parts,
+            &mut s.xi[k],
+            &mut s.active[k],
+            &mut s.out[k],
         );
-        if active[k] {
+        if s.active[k] {
             // only free particles gather (and clear their flag)
             for q in [p, i] {
                 if parts.inv_mass[q] > 0.0 {
