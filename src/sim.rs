@@ -218,6 +218,12 @@ const CHUNKS_PER_THREAD: usize = 8;
 /// free particle's.
 const SLOW_FRACTION: f64 = 0.1;
 
+/// How far a slow–slow [0], slow–fast [1] and fast–fast [2] pair can have closed its gap since
+/// the last build, from the displacement bounds of a slow [0] and a fast [1] particle (length).
+fn gap_closed(bound: [f64; 2]) -> [f64; 3] {
+    [2.0 * bound[0], bound[0] + bound[1], 2.0 * bound[1]]
+}
+
 fn key(p: u32, i: u32) -> u64 {
     ((p as u64) << 32) | i as u64
 }
@@ -557,14 +563,8 @@ impl<L: ContactLaw> Simulation<L> {
                         .fold(0.0, f64::max);
                     *b += m.sqrt() * view.dt;
                 }
-                // How far a slow–slow [0], slow–fast [1] and fast–fast [2] pair can have closed
-                // its gap.
-                let mut closed = [2.0 * bound[0], bound[0] + bound[1], 2.0 * bound[1]];
-                if closed.into_iter().fold(0.0, f64::max) > skin {
+                if gap_closed(bound).into_iter().fold(0.0, f64::max) > skin {
                     bound = [0.0; 2];
-                    // Nothing has moved since the new build: its pair pass visits only the
-                    // pairs already touching, and the live ends grow from there.
-                    closed = [0.0; 3];
                     barrier.wait();
                     let crew = Crew::Member {
                         tid,
@@ -575,6 +575,9 @@ impl<L: ContactLaw> Simulation<L> {
                     barrier.wait();
                     lap(&mut local.neighbor);
                 }
+                // After a rebuild nothing has moved since the new build: its pair pass visits
+                // only the pairs already touching, and the live ends grow from there.
+                let closed = gap_closed(bound);
                 while let Some(c) = pair_queue.next(tid) {
                     unsafe {
                         let l = list.get();
@@ -1267,8 +1270,7 @@ mod tests {
             e.advance(steps);
             let c = e.core();
             assert!(c.times.rebuilds >= 2, "no rebuild inside the run");
-            let b = c.moved_bound;
-            let closed = [2.0 * b[0], b[0] + b[1], 2.0 * b[1]];
+            let closed = super::gap_closed(c.moved_bound);
             let width = c.skin() / 16.0;
             let s = &c.scratch;
             for (seg, live) in s.pair_ranges.iter().zip(&s.live) {
