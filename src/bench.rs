@@ -4,6 +4,7 @@
 //! LIGGGHTS: their "Loop time"), so set-up and file reading are excluded for all.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -12,16 +13,22 @@ use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::peers::{self, Peer};
 use crate::sim::StageTimes;
+use crate::team::{Bound, SpinBarrier};
 
 /// One configuration: a code and its number of threads or MPI ranks.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Config {
     /// `copies` independent verdem runs of `threads` threads each, at the same time in one
     /// process; their rate is the sum of theirs. Two copies of one thread measure what this
-    /// machine gives two fully independent jobs: the ceiling of any 2-thread speed-up.
+    /// machine gives two fully independent jobs: the ceiling of any 2-thread speed-up. With
+    /// `lockstep`, copy k runs on the k-th CPU the process may use (as a team's thread k does)
+    /// and the copies wait for each other once a step at a shared barrier: they share no data
+    /// but synchronise as a team's threads do, which measures what this machine gives a job
+    /// that must meet its partner once a step.
     Verdem {
         threads: usize,
         copies: usize,
+        lockstep: bool,
     },
     Peer {
         peer: Peer,
@@ -33,11 +40,25 @@ impl Config {
     /// The code's name and its processes/threads column.
     pub fn label(&self) -> (String, String) {
         match self {
-            Config::Verdem { threads, copies: 1 } => {
-                ("verdem (deterministic)".into(), threads.to_string())
-            }
-            Config::Verdem { threads, copies } => (
+            Config::Verdem {
+                threads, copies: 1, ..
+            } => ("verdem (deterministic)".into(), threads.to_string()),
+            Config::Verdem {
+                threads,
+                copies,
+                lockstep: false,
+            } => (
                 format!("{copies} independent verdem runs at once (summed)"),
+                format!("{copies}×{threads}"),
+            ),
+            Config::Verdem {
+                threads,
+                copies,
+                lockstep: true,
+            } => (
+                format!(
+                    "{copies} independent verdem runs in lockstep: one barrier a step (summed)"
+                ),
                 format!("{copies}×{threads}"),
             ),
             Config::Peer { peer, np } => (format!("{peer:?}").to_lowercase(), np.to_string()),
@@ -103,7 +124,12 @@ pub fn run(
     for _ in 0..rounds {
         for m in out.iter_mut() {
             match &m.config {
-                Config::Verdem { threads, copies } => {
+                Config::Verdem {
+                    threads,
+                    copies,
+                    lockstep,
+                } => {
+                    let barrier = lockstep.then(|| Arc::new(SpinBarrier::new(*copies)));
                     let mut engines = (0..*copies)
                         .map(|_| {
                             let mut e = engine::build(
@@ -116,19 +142,29 @@ pub fn run(
                             );
                             e.advance(0);
                             e.core_mut().times = StageTimes::default();
+                            e.core_mut().lockstep = barrier.clone();
                             Ok(e)
                         })
                         .collect::<anyhow::Result<Vec<_>>>()?;
                     let t0 = Instant::now();
+                    let copies = *copies;
+                    let run = move |k: usize, e: &mut dyn crate::sim::Engine| {
+                        let _bound = barrier
+                            .is_some()
+                            .then(|| Bound::to_nth_cpu(k, copies))
+                            .flatten();
+                        advance_in_chunks(e, steps);
+                    };
                     std::thread::scope(|s| {
                         let (first, rest) = engines.split_at_mut(1);
-                        for e in rest {
-                            s.spawn(move || advance_in_chunks(e.as_mut(), steps));
+                        for (k, e) in rest.iter_mut().enumerate() {
+                            let run = &run;
+                            s.spawn(move || run(k + 1, e.as_mut()));
                         }
-                        advance_in_chunks(first[0].as_mut(), steps);
+                        run(0, first[0].as_mut());
                     });
                     m.rates
-                        .push((*copies as u64 * steps) as f64 / t0.elapsed().as_secs_f64());
+                        .push((copies as u64 * steps) as f64 / t0.elapsed().as_secs_f64());
                     m.stages = Some(engines[0].core().times);
                 }
                 Config::Peer { peer, np } => {
@@ -206,11 +242,17 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             best / x.median()
         ));
     }
-    let find = |threads: usize, copies: usize| {
-        m.iter()
-            .find(|x| x.config == Config::Verdem { threads, copies })
+    let find = |threads: usize, copies: usize, lockstep: bool| {
+        m.iter().find(|x| {
+            x.config
+                == Config::Verdem {
+                    threads,
+                    copies,
+                    lockstep,
+                }
+        })
     };
-    if let (Some(one), Some(two)) = (find(1, 1), find(2, 1)) {
+    if let (Some(one), Some(two)) = (find(1, 1, false), find(2, 1, false)) {
         let ratios = paired_ratios(one, two);
         let speedup = median(ratios.clone());
         let (lo, hi) = hinges(ratios.clone());
@@ -219,17 +261,30 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round; middle half of the rounds {lo:.2}–{hi:.2}; ≥ {SPEEDUP_GOAL} in {reached} of {} rounds)",
             ratios.len()
         ));
-        if let Some(pair) = find(1, 2) {
+        if let Some(pair) = find(1, 2, false) {
             let ceiling = paired_ratio(one, pair);
             s.push_str(&format!(
                 "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
                 100.0 * speedup / ceiling
             ));
         }
+        if let Some(coupled) = find(1, 2, true) {
+            let ceiling = paired_ratio(one, coupled);
+            s.push_str(&format!(
+                "; the same two runs waiting for each other once a step / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share no data but meet once a step, as a team's threads do; verdem's 2 threads reach {:.0} % of that",
+                100.0 * speedup / ceiling
+            ));
+        }
         s.push('\n');
     }
     for x in m {
-        if let (Config::Verdem { threads, copies: 1 }, Some(st)) = (&x.config, &x.stages) {
+        if let (
+            Config::Verdem {
+                threads, copies: 1, ..
+            },
+            Some(st),
+        ) = (&x.config, &x.stages)
+        {
             let total = (st.neighbor + st.forces + st.integrate + st.wait).max(1) as f64;
             let pct = |v: u64| 100.0 * v as f64 / total;
             s.push_str(&format!(
@@ -252,7 +307,9 @@ pub fn csv(m: &[Measured], particles: usize) -> String {
         let (code, n) = x.config.label();
         let rounds: Vec<String> = x.rates.iter().map(|r| format!("{r:.1}")).collect();
         s.push_str(&format!(
-            "{code},{n},{:.1},{:.1},{}\n",
+            "{},{},{:.1},{:.1},{}\n",
+            csv_field(&code),
+            csv_field(&n),
             x.median(),
             x.median() * particles as f64,
             rounds.join(" ")
@@ -261,13 +318,33 @@ pub fn csv(m: &[Measured], particles: usize) -> String {
     s
 }
 
+/// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break.
+fn csv_field(v: &str) -> String {
+    if v.contains([',', '"', '\n']) {
+        format!("\"{}\"", v.replace('"', "\"\""))
+    } else {
+        v.to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    #[test]
+    fn csv_fields_with_commas_or_quotes_are_quoted() {
+        assert_eq!(csv_field("lammps"), "lammps");
+        assert_eq!(csv_field("a, b"), "\"a, b\"");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+    }
+
     fn measured(threads: usize, copies: usize, rates: &[f64]) -> Measured {
         Measured {
-            config: Config::Verdem { threads, copies },
+            config: Config::Verdem {
+                threads,
+                copies,
+                lockstep: false,
+            },
             rates: rates.to_vec(),
             stages: None,
         }
@@ -316,5 +393,36 @@ mod tests {
         assert!(md.contains("| 2 independent verdem runs at once (summed) | 2×1 | 190 |"));
         // the ceiling row is not a verdem configuration: "verdem best" is the 2-thread rate
         assert!(md.contains("| verdem (deterministic) | 1 | 100 | 100, 110, 90 | 1.000e3 | 1.43 |"));
+        assert!(!md.contains("once a step"), "{md}");
+    }
+
+    #[test]
+    fn the_table_puts_the_two_thread_ratio_against_runs_that_meet_once_a_step() {
+        let mut coupled = measured(1, 2, &[160.0, 154.0, 144.0]);
+        coupled.config = Config::Verdem {
+            threads: 1,
+            copies: 2,
+            lockstep: true,
+        };
+        let m = [
+            measured(1, 1, &[100.0, 110.0, 90.0]),
+            measured(2, 1, &[150.0, 143.0, 126.0]),
+            coupled,
+        ];
+        let md = markdown(&m, 10);
+        // coupled ratios 1.6, 1.4, 1.6: median 1.6; 2/1 median 1.4
+        assert!(
+            md.contains(
+                "meet once a step, as a team's threads do; verdem's 2 threads reach 88 % of that"
+            ),
+            "{md}"
+        );
+        assert!(
+            md.contains(
+                "| 2 independent verdem runs in lockstep: one barrier a step (summed) | 2×1 | 154 |"
+            ),
+            "{md}"
+        );
+        assert!(!md.contains("share nothing"), "{md}");
     }
 }

@@ -116,8 +116,10 @@ enum Command {
         /// Alternating rounds.
         #[arg(long, default_value_t = 3)]
         rounds: usize,
-        /// Skip the ceiling row: two independent 1-thread verdem runs at once, which measures
-        /// what this machine gives two jobs that share nothing.
+        /// Skip the ceiling rows: two independent 1-thread verdem runs at once, which measures
+        /// what this machine gives two jobs that share nothing, and the same two runs waiting
+        /// for each other once a step, which measures what it gives two that meet once a step
+        /// as a team's threads do.
         #[arg(long)]
         no_ceiling: bool,
         /// Where the table (bench.md, bench.csv) and the peers' inputs go.
@@ -408,13 +410,15 @@ fn real_main() -> anyhow::Result<()> {
                 .map(|&t| bench::Config::Verdem {
                     threads: t,
                     copies: 1,
+                    lockstep: false,
                 })
                 .collect();
             if !no_ceiling {
-                configs.push(bench::Config::Verdem {
+                configs.extend([false, true].map(|lockstep| bench::Config::Verdem {
                     threads: 1,
                     copies: 2,
-                });
+                    lockstep,
+                }));
             }
             for name in peers.iter().filter(|p| !p.is_empty()) {
                 let peer = match name.as_str() {

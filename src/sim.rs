@@ -25,6 +25,7 @@
 //! identical for all.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use crate::contact::{ContactLaw, PairForce, PairInput};
@@ -117,6 +118,11 @@ pub struct Core {
     /// one step, as MercuryDPM's does (true, the default); LAMMPS and LIGGGHTS skip the
     /// history update during their setup (`update->setupflag`), which cross-runs mirror.
     pub setup_advances_history: bool,
+    /// A barrier shared with other runs, on which thread 0 waits once a step, after the particle
+    /// pass (where a team's threads meet); `None` for a normal run. `verdem bench` couples
+    /// independent 1-thread runs by it to measure what this machine gives jobs that share no
+    /// data but wait for each other once a step, as a team does.
+    pub lockstep: Option<Arc<SpinBarrier>>,
     pub times: StageTimes,
     /// Set by the pair pass for both particles of every contact, read and cleared by the next
     /// particle pass: a particle without contacts skips the gather (its sum is exactly zero).
@@ -256,6 +262,7 @@ impl Core {
             threads,
             bind: true,
             setup_advances_history: true,
+            lockstep: None,
             times: StageTimes::default(),
             touched: Vec::new(),
             near_face: Vec::new(),
@@ -482,6 +489,7 @@ impl<L: ContactLaw> Simulation<L> {
         core.quiet.fill(false);
         core.scratch.reset_live();
         let domain = core.domain.clone();
+        let lockstep = core.lockstep.clone();
         let view = StepView {
             law: &self.law,
             domain: &domain,
@@ -548,6 +556,9 @@ impl<L: ContactLaw> Simulation<L> {
                 lap(&mut local.integrate);
                 local.count_wait_in_integrate(waited);
                 barrier.wait();
+                if let (0, Some(other_runs)) = (tid, &lockstep) {
+                    other_runs.wait();
+                }
                 lap(&mut local.wait);
                 // A home is refilled only once its last pass is over (no thread takes from an
                 // emptied home); the pair queue starts full for the first step.

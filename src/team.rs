@@ -46,6 +46,11 @@ impl SpinBarrier {
         }
     }
 
+    /// Rounds completed so far (wrapping at 2³²); always 0 for a barrier of one thread.
+    pub fn rounds(&self) -> u32 {
+        self.round.load(Ordering::Acquire)
+    }
+
     /// Blocks until all `threads` threads have called `wait` for this round.
     #[inline]
     pub fn wait(&self) {

@@ -1,4 +1,4 @@
-//! `verdem bench` end to end: verdem, the ceiling row and the installed peers (Debian's LAMMPS
+//! `verdem bench` end to end: verdem, the ceiling rows and the installed peers (Debian's LAMMPS
 //! and LIGGGHTS under OpenMPI's mpirun) run on the same state, and the tables list every
 //! configuration with a measured rate. Rates are not judged here (no timings in tests).
 
@@ -33,6 +33,10 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
             ("verdem (deterministic)", "1"),
             ("verdem (deterministic)", "2"),
             ("2 independent verdem runs at once (summed)", "2×1"),
+            (
+                "2 independent verdem runs in lockstep: one barrier a step (summed)",
+                "2×1"
+            ),
             ("lammps", "1"),
             ("lammps", "2"),
             ("liggghts", "1"),
@@ -43,5 +47,9 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
     let md = std::fs::read_to_string(dir.path().join("bench.md")).unwrap();
     assert_eq!(md, String::from_utf8_lossy(&out.stdout));
     assert!(md.contains("verdem 2 threads / 1 thread: "), "{md}");
+    assert!(
+        md.contains("the same two runs waiting for each other once a step / 1 run alone: "),
+        "{md}"
+    );
     assert!(md.contains("neighbour list"), "{md}");
 }

@@ -93,6 +93,37 @@ fn threads_skin_and_cell_size_do_not_change_a_bit() {
     assert_eq!(run(2, true, 0.05, 2.7), reference, "skin 0.05, cell 2.7");
 }
 
+/// Runs coupled by a lockstep barrier (`verdem bench`'s ceiling row of runs that meet once a
+/// step) wait on it once a step, in every call, and keep the bits of a run alone.
+#[test]
+fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
+    let case = quick_case();
+    let state = shared("states/mercury_t143.85.data");
+    let reference = hash_after(
+        engine(&case, Some(&state), Overrides::default()).as_mut(),
+        700,
+    );
+    let barrier = std::sync::Arc::new(verdem::team::SpinBarrier::new(2));
+    let hashes: Vec<String> = std::thread::scope(|s| {
+        let runs: Vec<_> = (0..2)
+            .map(|_| {
+                let barrier = barrier.clone();
+                let (case, state) = (&case, &state);
+                s.spawn(move || {
+                    let mut e = engine(case, Some(state), Overrides::default());
+                    e.core_mut().lockstep = Some(barrier);
+                    // several calls, each a run of its own (the first with a rebuild)
+                    e.advance(300);
+                    hash_after(e.as_mut(), 400)
+                })
+            })
+            .collect();
+        runs.into_iter().map(|r| r.join().unwrap()).collect()
+    });
+    assert_eq!(barrier.rounds(), 700);
+    assert_eq!(hashes, [reference.clone(), reference]);
+}
+
 /// The hash sees every bit: one ulp in one velocity changes it.
 #[test]
 fn one_ulp_in_one_velocity_changes_the_hash() {
