@@ -18,13 +18,14 @@ use crate::team::{Bound, SpinBarrier};
 /// One configuration: a code and its number of threads or MPI ranks.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Config {
-    /// `copies` independent verdem runs of `threads` threads each, at the same time in one
-    /// process; their rate is the sum of theirs. Two copies of one thread measure what this
-    /// machine gives two fully independent jobs: the ceiling of any 2-thread speed-up. With
-    /// `lockstep`, copy k runs on the k-th CPU the process may use (as a team's thread k does)
-    /// and the copies wait for each other once a step at a shared barrier: they share no data
-    /// but synchronise as a team's threads do, which measures what this machine gives a job
-    /// that must meet its partner once a step.
+    /// `copies` independent verdem runs of `threads` threads each, started together in one
+    /// process, copy k bound to the k-th CPU the process may use (as a team's thread k is) when
+    /// there are more copies than one; their rate is the sum of each copy's own rate (its steps
+    /// over the time from the common start to its own end), so a CPU that finishes early does
+    /// not count as idle. Two copies of one thread measure what this machine gives two fully
+    /// independent jobs: the ceiling of any 2-thread speed-up. With `lockstep` the copies wait
+    /// for each other once a step at a shared barrier: they share no data but meet once a step
+    /// with a fixed half of the work each, as a statically split code's threads or ranks do.
     Verdem {
         threads: usize,
         copies: usize,
@@ -71,6 +72,9 @@ impl Config {
 pub struct Measured {
     pub config: Config,
     pub rates: Vec<f64>,
+    /// Each copy's own rate in each round, when the configuration runs several copies (copy k
+    /// on CPU k); empty otherwise.
+    pub copy_rates: Vec<Vec<f64>>,
     pub stages: Option<StageTimes>,
 }
 
@@ -118,6 +122,7 @@ pub fn run(
         .map(|c| Measured {
             config: c.clone(),
             rates: Vec::new(),
+            copy_rates: Vec::new(),
             stages: None,
         })
         .collect();
@@ -146,25 +151,33 @@ pub fn run(
                             Ok(e)
                         })
                         .collect::<anyhow::Result<Vec<_>>>()?;
-                    let t0 = Instant::now();
                     let copies = *copies;
-                    let run = move |k: usize, e: &mut dyn crate::sim::Engine| {
-                        let _bound = barrier
-                            .is_some()
-                            .then(|| Bound::to_nth_cpu(k, copies))
-                            .flatten();
+                    let start = std::sync::Barrier::new(copies);
+                    let run = |k: usize, e: &mut dyn crate::sim::Engine| {
+                        let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
+                        start.wait();
+                        let t0 = Instant::now();
                         advance_in_chunks(e, steps);
+                        steps as f64 / t0.elapsed().as_secs_f64()
                     };
-                    std::thread::scope(|s| {
+                    let own: Vec<f64> = std::thread::scope(|s| {
                         let (first, rest) = engines.split_at_mut(1);
-                        for (k, e) in rest.iter_mut().enumerate() {
-                            let run = &run;
-                            s.spawn(move || run(k + 1, e.as_mut()));
-                        }
-                        run(0, first[0].as_mut());
+                        let others: Vec<_> = rest
+                            .iter_mut()
+                            .enumerate()
+                            .map(|(k, e)| {
+                                let run = &run;
+                                s.spawn(move || run(k + 1, e.as_mut()))
+                            })
+                            .collect();
+                        let mut own = vec![run(0, first[0].as_mut())];
+                        own.extend(others.into_iter().map(|h| h.join().expect("copy runs")));
+                        own
                     });
-                    m.rates
-                        .push((copies as u64 * steps) as f64 / t0.elapsed().as_secs_f64());
+                    m.rates.push(own.iter().sum());
+                    if copies > 1 {
+                        m.copy_rates.push(own);
+                    }
                     m.stages = Some(engines[0].core().times);
                 }
                 Config::Peer { peer, np } => {
@@ -267,6 +280,14 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
                 "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
                 100.0 * speedup / ceiling
             ));
+            let cpus: Vec<f64> = pair.copy_rates.iter().map(|r| r[1] / r[0]).collect();
+            if !cpus.is_empty() {
+                let (lo, hi) = hinges(cpus.clone());
+                s.push_str(&format!(
+                    " (the run on CPU 1 ran at {:.2}× the rate of the run on CPU 0, middle half of the rounds {lo:.2}–{hi:.2}: a fixed half of the work each would run at the slower one's pace)",
+                    median(cpus)
+                ));
+            }
         }
         if let Some(coupled) = find(1, 2, true) {
             let ceiling = paired_ratio(one, coupled);
@@ -346,6 +367,7 @@ mod tests {
                 lockstep: false,
             },
             rates: rates.to_vec(),
+            copy_rates: Vec::new(),
             stages: None,
         }
     }
@@ -379,12 +401,16 @@ mod tests {
 
     #[test]
     fn the_table_puts_the_two_thread_ratio_against_the_ceiling() {
+        let mut pair = measured(1, 2, &[190.0, 198.0, 180.0]);
+        pair.copy_rates = vec![vec![100.0, 90.0], vec![100.0, 98.0], vec![90.0, 90.0]];
         let m = [
             measured(1, 1, &[100.0, 110.0, 90.0]),
             measured(2, 1, &[150.0, 143.0, 126.0]),
-            measured(1, 2, &[190.0, 198.0, 180.0]),
+            pair,
         ];
         let md = markdown(&m, 10);
+        // CPU 1 / CPU 0: 0.9, 0.98, 1
+        assert!(md.contains("CPU 1 ran at 0.98× the rate of the run on CPU 0, middle half of the rounds 0.94–0.99"), "{md}");
         // 2/1 ratios 1.5, 1.3, 1.4; ceiling ratios 1.9, 1.8, 2.0
         assert!(md.contains("verdem 2 threads / 1 thread: 1.40"), "{md}");
         assert!(md.contains("middle half of the rounds 1.35–1.45; ≥ 1.7 in 0 of 3 rounds"));

@@ -51,5 +51,6 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
         md.contains("the same two runs waiting for each other once a step / 1 run alone: "),
         "{md}"
     );
+    assert!(md.contains("the run on CPU 1 ran at "), "{md}");
     assert!(md.contains("neighbour list"), "{md}");
 }
