@@ -153,7 +153,7 @@ pub fn run(
                         .collect::<anyhow::Result<Vec<_>>>()?;
                     let copies = *copies;
                     let start = std::sync::Barrier::new(copies);
-                    let run = |k: usize, e: &mut dyn crate::sim::Engine| {
+                    let time_copy = |k: usize, e: &mut dyn crate::sim::Engine| {
                         let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
                         start.wait();
                         let t0 = Instant::now();
@@ -166,11 +166,11 @@ pub fn run(
                             .iter_mut()
                             .enumerate()
                             .map(|(k, e)| {
-                                let run = &run;
-                                s.spawn(move || run(k + 1, e.as_mut()))
+                                let time_copy = &time_copy;
+                                s.spawn(move || time_copy(k + 1, e.as_mut()))
                             })
                             .collect();
-                        let mut own = vec![run(0, first[0].as_mut())];
+                        let mut own = vec![time_copy(0, first[0].as_mut())];
                         own.extend(others.into_iter().map(|h| h.join().expect("copy runs")));
                         own
                     });
