@@ -215,11 +215,6 @@ fn paired_ratios(a: &Measured, b: &Measured) -> Vec<f64> {
     a.rates.iter().zip(&b.rates).map(|(x, y)| y / x).collect()
 }
 
-/// The median over the rounds of the rate of `b` over that of `a` in the same round.
-pub fn paired_ratio(a: &Measured, b: &Measured) -> f64 {
-    median(paired_ratios(a, b))
-}
-
 /// Tukey's hinges of `r` (the medians of its lower and upper halves, each with the middle
 /// value when their count is odd): the spread of the middle half of the rounds.
 fn hinges(mut r: Vec<f64>) -> (f64, f64) {
@@ -234,6 +229,61 @@ fn hinges(mut r: Vec<f64>) -> (f64, f64) {
 /// The speed-up of 2 threads over 1 that issue #7 asks of verdem; the table counts the rounds
 /// that reach it.
 const SPEEDUP_GOAL: f64 = 1.7;
+
+/// How many times a peer's rate on 2 ranks issue #7 asks of verdem on 2 threads.
+const PEER_GOAL: f64 = 5.0;
+
+/// The confidence of the interval [`median_interval`] gives.
+const CONFIDENCE: f64 = 0.95;
+
+/// A distribution-free interval for the median of the distribution `r` is drawn from, taking
+/// its values as independent: the k-th smallest and the k-th largest value, with the largest k
+/// for which the interval covers the median with probability ≥ [`CONFIDENCE`] (it misses only
+/// when k or more values fall on one side of the median, each with probability ½: a binomial
+/// tail; Conover, *Practical Nonparametric Statistics*, 3rd ed., §3.2). `None` with fewer than
+/// six values, which no such interval reaches.
+fn median_interval(mut r: Vec<f64>) -> Option<(f64, f64)> {
+    r.sort_by(f64::total_cmp);
+    let n = r.len();
+    // P(at most j of n values below the median) for j = 0, 1, …, summed in log space so that
+    // 2⁻ⁿ does not underflow for long runs.
+    let ln_half_n = -(n as f64) * std::f64::consts::LN_2;
+    let mut ln_term = ln_half_n;
+    let mut tail = 0.0;
+    let mut k = 0;
+    for j in 0..n.div_ceil(2) {
+        if j > 0 {
+            ln_term += ((n - j + 1) as f64 / j as f64).ln();
+        }
+        tail += ln_term.exp();
+        if 2.0 * tail > 1.0 - CONFIDENCE {
+            break;
+        }
+        k = j + 1;
+    }
+    (k > 0).then(|| (r[k - 1], r[n - k]))
+}
+
+/// [`median_interval`] of the values `r`, in words.
+fn interval(r: &[f64]) -> String {
+    let pct = 100.0 * CONFIDENCE;
+    match median_interval(r.to_vec()) {
+        Some((lo, hi)) => format!("{pct:.0} % interval of the median {lo:.3}–{hi:.3}"),
+        None => format!("a {pct:.0} % interval of the median needs 6 rounds or more"),
+    }
+}
+
+/// Whether the median of the distribution the values `r` are drawn from reaches `goal`:
+/// "met" when all of [`median_interval`] does, "not met" when none does, "undecided" when it
+/// holds the goal or there are too few values for one; followed by the interval.
+fn verdict(r: &[f64], goal: f64) -> String {
+    let word = match median_interval(r.to_vec()) {
+        Some((lo, _)) if lo >= goal => "met",
+        Some((_, hi)) if hi < goal => "not met",
+        _ => "undecided",
+    };
+    format!("{word} ({})", interval(r))
+}
 
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
 /// particle-steps/s, and verdem's best rate over the code's.
@@ -271,13 +321,16 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
         let (lo, hi) = hinges(ratios.clone());
         let reached = ratios.iter().filter(|&&r| r >= SPEEDUP_GOAL).count();
         s.push_str(&format!(
-            "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round; middle half of the rounds {lo:.2}–{hi:.2}; ≥ {SPEEDUP_GOAL} in {reached} of {} rounds)",
-            ratios.len()
+            "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round; middle half of the rounds {lo:.2}–{hi:.2}; ≥ {SPEEDUP_GOAL} in {reached} of {} rounds; goal ≥ {SPEEDUP_GOAL}: {})",
+            ratios.len(),
+            verdict(&ratios, SPEEDUP_GOAL)
         ));
         if let Some(pair) = find(1, 2, false) {
-            let ceiling = paired_ratio(one, pair);
+            let ratios = paired_ratios(one, pair);
+            let ceiling = median(ratios.clone());
             s.push_str(&format!(
-                "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
+                "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2} ({}), what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
+                interval(&ratios),
                 100.0 * speedup / ceiling
             ));
             let cpus: Vec<f64> = pair.copy_rates.iter().map(|r| r[1] / r[0]).collect();
@@ -290,13 +343,29 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             }
         }
         if let Some(coupled) = find(1, 2, true) {
-            let ceiling = paired_ratio(one, coupled);
+            let ratios = paired_ratios(one, coupled);
+            let ceiling = median(ratios.clone());
             s.push_str(&format!(
-                "; the same two runs waiting for each other once a step / 1 run alone: {ceiling:.2}, what this machine gives two jobs that share no data but meet once a step, as a team's threads do; verdem's 2 threads reach {:.0} % of that",
+                "; the same two runs waiting for each other once a step / 1 run alone: {ceiling:.2} ({}), what this machine gives two jobs that share no data but meet once a step, as a team's threads do; verdem's 2 threads reach {:.0} % of that",
+                interval(&ratios),
                 100.0 * speedup / ceiling
             ));
         }
         s.push('\n');
+    }
+    if let Some(two) = find(2, 1, false) {
+        for peer in m
+            .iter()
+            .filter(|x| matches!(x.config, Config::Peer { np: 2, .. }))
+        {
+            let ratios = paired_ratios(peer, two);
+            s.push_str(&format!(
+                "\nverdem 2 threads / {} 2 ranks: {:.2} (median over the rounds of the ratio within a round); goal ≥ {PEER_GOAL}: {}\n",
+                peer.config.label().0,
+                median(ratios.clone()),
+                verdict(&ratios, PEER_GOAL)
+            ));
+        }
     }
     for x in m {
         if let (
@@ -379,8 +448,8 @@ mod tests {
             measured(1, 1, &[1.0, 2.0, 10.0]),
             measured(2, 1, &[3.0, 2.0, 5.0]),
         );
-        assert_eq!(paired_ratio(&a, &b), 1.0);
         assert_eq!(b.median() / a.median(), 1.5);
+        assert!(markdown(&[a, b], 10).contains("verdem 2 threads / 1 thread: 1.00 (median"));
     }
 
     #[test]
@@ -388,6 +457,68 @@ mod tests {
         assert_eq!(hinges(vec![5.0, 1.0, 3.0, 2.0, 4.0]), (2.0, 4.0));
         assert_eq!(hinges(vec![4.0, 1.0, 3.0, 2.0]), (1.5, 3.5));
         assert_eq!(hinges(vec![7.0]), (7.0, 7.0));
+    }
+
+    #[test]
+    fn the_median_interval_is_the_widest_order_statistics_the_binomial_tail_allows() {
+        let values = |n: usize| (1..=n).rev().map(|v| v as f64).collect::<Vec<f64>>();
+        assert_eq!(median_interval(values(5)), None);
+        // n = 6: P(0 below) = 1/64 per side, 3.1 % in all; P(≤ 1 below) = 7/64 is too much
+        assert_eq!(median_interval(values(6)), Some((1.0, 6.0)));
+        // n = 10: P(≤ 1) = 11/1024 per side, 2.1 % in all; P(≤ 2) = 56/1024, 10.9 %
+        assert_eq!(median_interval(values(10)), Some((2.0, 9.0)));
+        // n = 20: P(≤ 5) = 21700/2²⁰ per side, 4.1 % in all; P(≤ 6) = 60460/2²⁰, 11.5 %
+        assert_eq!(median_interval(values(20)), Some((6.0, 15.0)));
+        // n = 30: P(≤ 9) = 2.1 % per side, 4.3 % in all; P(≤ 10) = 4.9 % per side is too much
+        assert_eq!(median_interval(values(30)), Some((10.0, 21.0)));
+        // n = 2000: 2⁻²⁰⁰⁰ underflows an f64; the normal approximation puts k near
+        // 1000 − 1.96·√2000/2 ≈ 956
+        let (lo, hi) = median_interval(values(2000)).unwrap();
+        assert!((950.0..=960.0).contains(&lo), "{lo}");
+        assert_eq!(hi, 2001.0 - lo);
+    }
+
+    #[test]
+    fn the_verdict_says_met_only_when_the_whole_interval_reaches_the_goal() {
+        let at = |v: &[f64]| verdict(v, 1.7);
+        assert_eq!(
+            at(&[1.8, 1.75, 1.9, 2.0, 1.71, 1.85]),
+            "met (95 % interval of the median 1.710–2.000)"
+        );
+        assert_eq!(
+            at(&[1.5, 1.6, 1.65, 1.69, 1.4, 1.55]),
+            "not met (95 % interval of the median 1.400–1.690)"
+        );
+        assert!(at(&[1.5, 1.6, 1.65, 1.69, 1.4, 1.75]).starts_with("undecided (95 %"));
+        assert_eq!(
+            at(&[2.0, 2.0, 2.0]),
+            "undecided (a 95 % interval of the median needs 6 rounds or more)"
+        );
+    }
+
+    #[test]
+    fn the_table_judges_verdem_against_each_peer_on_two_ranks() {
+        let peer = |np: usize, rates: &[f64]| Measured {
+            config: Config::Peer {
+                peer: Peer::Lammps,
+                np,
+            },
+            rates: rates.to_vec(),
+            copy_rates: Vec::new(),
+            stages: None,
+        };
+        let m = [
+            measured(2, 1, &[60.0, 55.0, 70.0, 50.0, 65.0, 58.0]),
+            peer(1, &[9.0; 6]),
+            peer(2, &[10.0, 10.0, 10.0, 10.0, 10.0, 12.0]),
+        ];
+        let md = markdown(&m, 10);
+        // ratios 6, 5.5, 7, 5, 6.5, 4.83: median 5.75, interval 4.83–7
+        assert!(
+            md.contains("verdem 2 threads / lammps 2 ranks: 5.75 (median over the rounds of the ratio within a round); goal ≥ 5: undecided (95 % interval of the median 4.833–7.000)"),
+            "{md}"
+        );
+        assert!(!md.contains("lammps 1 ranks"), "{md}");
     }
 
     #[test]
@@ -414,7 +545,10 @@ mod tests {
         // 2/1 ratios 1.5, 1.3, 1.4; ceiling ratios 1.9, 1.8, 2.0
         assert!(md.contains("verdem 2 threads / 1 thread: 1.40"), "{md}");
         assert!(md.contains("middle half of the rounds 1.35–1.45; ≥ 1.7 in 0 of 3 rounds"));
-        assert!(md.contains("at once / 1 run alone: 1.90"), "{md}");
+        assert!(
+            md.contains("at once / 1 run alone: 1.90 (a 95 % interval of the median needs 6"),
+            "{md}"
+        );
         assert!(md.contains("reach 74 % of that"), "{md}");
         assert!(md.contains("| 2 independent verdem runs at once (summed) | 2×1 | 190 |"));
         // the ceiling row is not a verdem configuration: "verdem best" is the 2-thread rate

@@ -52,5 +52,13 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
         "{md}"
     );
     assert!(md.contains("the run on CPU 1 ran at "), "{md}");
+    for peer in ["lammps", "liggghts"] {
+        assert!(
+            md.contains(&format!("verdem 2 threads / {peer} 2 ranks: ")),
+            "{md}"
+        );
+    }
+    // one round: too few for an interval, so no goal is judged met or not met
+    assert!(md.contains("goal ≥ 5: undecided (a 95 % interval"), "{md}");
     assert!(md.contains("neighbour list"), "{md}");
 }
