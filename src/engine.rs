@@ -26,6 +26,7 @@ pub struct Overrides {
 /// Something done with the contact law of a case, whichever concrete type it composes to.
 pub trait LawVisitor {
     type Output;
+    /// Does the job with the composed law `law`.
     fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Self::Output;
 }
 

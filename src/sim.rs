@@ -396,7 +396,9 @@ pub struct Simulation<L: ContactLaw> {
 
 /// The law-independent face of a simulation, for the run loop and the tools.
 pub trait Engine: Send {
+    /// The state and settings the law does not own.
     fn core(&self) -> &Core;
+    /// The same, to change between calls of [`Engine::advance`].
     fn core_mut(&mut self) -> &mut Core;
     /// Advances `steps` time steps (evaluating the initial forces first if needed).
     fn advance(&mut self, steps: u64);
@@ -432,6 +434,7 @@ struct StepView<'a, L> {
 }
 
 impl<L: ContactLaw> Simulation<L> {
+    /// A simulation of `core` under the contact law `law`.
     pub fn new(law: L, core: Core) -> Self {
         Simulation { law, core }
     }

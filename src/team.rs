@@ -37,6 +37,7 @@ pub struct SpinBarrier {
 }
 
 impl SpinBarrier {
+    /// A barrier for `threads` threads (a barrier of one never waits).
     pub fn new(threads: usize) -> Self {
         SpinBarrier {
             threads,
@@ -330,6 +331,7 @@ pub struct Shared<T>(UnsafeCell<T>);
 unsafe impl<T: Send> Sync for Shared<T> {}
 
 impl<T> Shared<T> {
+    /// Shares `value` among a team's threads.
     pub fn new(value: T) -> Self {
         Shared(UnsafeCell::new(value))
     }

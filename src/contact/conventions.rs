@@ -21,6 +21,8 @@ use crate::Vec3;
 /// How the relative tangential velocity at the contact is formed (over the step `dt` that
 /// ends at the current positions).
 pub trait Slip: Send + Sync {
+    /// The tangential relative velocity of P with respect to I at the contact (length/time),
+    /// perpendicular to the normal (unit, from I to P); `dt` is the time step (time).
     fn slip(k: &PairKinematics, dt: f64) -> Vec3;
 }
 
@@ -191,6 +193,10 @@ impl FrameUpdate for ExactRotation {
 /// The Coulomb cap: the tangential force on P from the spring ξ and the slip, with ξ reset
 /// when sliding.
 pub trait Cap: Send + Sync {
+    /// The tangential force on P (force units) from the spring ξ (length) and the dashpot on
+    /// `slip` (length/time), limited to the critical force `fcrit` = μ|fn| in the way the
+    /// convention states, resetting ξ when the contact slides. `kt` in force/length, `gammat`
+    /// in mass/time.
     fn cap(xi: &mut Vec3, slip: Vec3, fcrit: f64, kt: f64, gammat: f64) -> Vec3;
 }
 
@@ -274,6 +280,8 @@ pub struct Convention<S, U, C, const FULL_LEVER: bool> {
 type Parts<S, U, C> = PhantomData<fn() -> (S, U, C)>;
 
 impl<S, U, C, const FULL_LEVER: bool> Convention<S, U, C, FULL_LEVER> {
+    /// A tangential law with spring `kt` (force/length), dashpot `gammat` (mass/time, absolute)
+    /// and Coulomb coefficient `mu`.
     pub fn new(kt: f64, gammat: f64, mu: f64) -> Self {
         Convention {
             kt,

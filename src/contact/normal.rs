@@ -4,6 +4,8 @@
 /// A normal force model: signed normal force from the overlap δ > 0 and the normal relative
 /// velocity vn = (v_P − v_I)·n at the contact point (negative while approaching).
 pub trait NormalModel: Send + Sync {
+    /// The signed normal force on P along n (force units; positive repulsive) for the overlap
+    /// `delta` (length, > 0) and the normal relative velocity `vn` (length/time).
     fn force(&self, delta: f64, vn: f64) -> f64;
 }
 

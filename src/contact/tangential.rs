@@ -12,6 +12,9 @@ pub trait TangentialModel: Send + Sync {
     /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
     /// arms to the contact point in the middle of the overlap.
     const FULL_RADIUS_LEVER: bool = false;
+    /// The tangential force on P (force units) for a contact with kinematics `k`, signed normal
+    /// force `fn_signed` (positive repulsive), elastic tangential displacement `xi` (length,
+    /// updated in place) and time step `dt` (time).
     fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3;
 }
 
