@@ -264,10 +264,10 @@ fn median_interval(mut r: Vec<f64>) -> Option<(f64, f64)> {
     (k > 0).then(|| (r[k - 1], r[n - k]))
 }
 
-/// [`median_interval`] of the values `r`, in words.
-fn interval(r: &[f64]) -> String {
+/// An interval from [`median_interval`], in words.
+fn interval(found: Option<(f64, f64)>) -> String {
     let pct = 100.0 * CONFIDENCE;
-    match median_interval(r.to_vec()) {
+    match found {
         Some((lo, hi)) => format!("{pct:.0} % interval of the median {lo:.3}–{hi:.3}"),
         None => format!("a {pct:.0} % interval of the median needs 6 rounds or more"),
     }
@@ -277,12 +277,13 @@ fn interval(r: &[f64]) -> String {
 /// "met" when all of [`median_interval`] does, "not met" when none does, "undecided" when it
 /// holds the goal or there are too few values for one; followed by the interval.
 fn verdict(r: &[f64], goal: f64) -> String {
-    let word = match median_interval(r.to_vec()) {
+    let found = median_interval(r.to_vec());
+    let word = match found {
         Some((lo, _)) if lo >= goal => "met",
         Some((_, hi)) if hi < goal => "not met",
         _ => "undecided",
     };
-    format!("{word} ({})", interval(r))
+    format!("{word} ({})", interval(found))
 }
 
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
@@ -325,13 +326,21 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             ratios.len(),
             verdict(&ratios, SPEEDUP_GOAL)
         ));
-        if let Some(pair) = find(1, 2, false) {
-            let ratios = paired_ratios(one, pair);
+        // A ceiling row against 1 thread alone, and verdem's 2 threads against the ceiling.
+        let ceiling = |row: &Measured, runs: &str, gives: &str| {
+            let ratios = paired_ratios(one, row);
             let ceiling = median(ratios.clone());
-            s.push_str(&format!(
-                "; 2 independent 1-thread runs at once / 1 run alone: {ceiling:.2} ({}), what this machine gives two jobs that share nothing; verdem's 2 threads reach {:.0} % of that",
-                interval(&ratios),
+            format!(
+                "; {runs} / 1 run alone: {ceiling:.2} ({}), what this machine gives {gives}; verdem's 2 threads reach {:.0} % of that",
+                interval(median_interval(ratios)),
                 100.0 * speedup / ceiling
+            )
+        };
+        if let Some(pair) = find(1, 2, false) {
+            s.push_str(&ceiling(
+                pair,
+                "2 independent 1-thread runs at once",
+                "two jobs that share nothing",
             ));
             let cpus: Vec<f64> = pair.copy_rates.iter().map(|r| r[1] / r[0]).collect();
             if !cpus.is_empty() {
@@ -343,12 +352,10 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             }
         }
         if let Some(coupled) = find(1, 2, true) {
-            let ratios = paired_ratios(one, coupled);
-            let ceiling = median(ratios.clone());
-            s.push_str(&format!(
-                "; the same two runs waiting for each other once a step / 1 run alone: {ceiling:.2} ({}), what this machine gives two jobs that share no data but meet once a step, as a team's threads do; verdem's 2 threads reach {:.0} % of that",
-                interval(&ratios),
-                100.0 * speedup / ceiling
+            s.push_str(&ceiling(
+                coupled,
+                "the same two runs waiting for each other once a step",
+                "two jobs that share no data but meet once a step, as a team's threads do",
             ));
         }
         s.push('\n');
