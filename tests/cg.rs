@@ -283,3 +283,45 @@ fn malformed_files_are_rejected_with_file_and_line() {
         "{e}"
     );
 }
+
+/// A check against error bars is judged only when there are two blocks or more: one save gives
+/// no standard error, and its χ² would be infinite.
+#[test]
+fn checks_against_error_bars_need_two_blocks() {
+    let dir = tempfile::tempdir().unwrap();
+    // a layer of spheres near the bottom only: far from symmetric about the mid-plane
+    let layer = |vx: f64| -> Vec<([f64; 3], [f64; 3])> {
+        (0..20)
+            .map(|a| {
+                let x = [(a % 4) as f64 + 0.5, (a / 4) as f64 + 0.5, 1.0];
+                (x, [vx + 0.01 * a as f64, 0.0, 0.0])
+            })
+            .collect()
+    };
+    let judge = |saves: u64| {
+        for k in 0..saves {
+            save(dir.path(), k, &layer(0.1 * (k + 1) as f64), &[]);
+        }
+        let p = profiles(dir.path(), &options(0, KernelChoice::Heaviside));
+        let checks = cg::checks::run(&p, 1.0);
+        (p.blocks, cg::checks::report(&p, &checks), checks)
+    };
+    let (blocks, report, checks) = judge(1);
+    assert_eq!(blocks, 1, "{report}");
+    let symmetric = |c: &[cg::checks::Check]| {
+        c.iter()
+            .find(|c| c.name == "symmetric nu about the mid-plane")
+            .unwrap()
+            .pass
+    };
+    assert_eq!(symmetric(&checks), None, "{report}");
+    assert!(!report.contains("FAIL"), "{report}");
+    assert!(
+        report.contains("not judged: 1 block gives no error bar"),
+        "{report}"
+    );
+    let (blocks, report, checks) = judge(2);
+    assert_eq!(blocks, 2, "{report}");
+    assert_eq!(symmetric(&checks), Some(false), "{report}");
+    assert!(!report.contains("not judged"), "{report}");
+}
