@@ -30,7 +30,7 @@ struct Common {
     #[arg(long)]
     init: Option<PathBuf>,
     /// Worker threads of the time step.
-    #[arg(long)]
+    #[arg(long, value_parser = count::<usize>)]
     threads: Option<usize>,
     /// Leave the threads to the scheduler: by default thread t of a team of two or more runs on
     /// the t-th CPU the process may use (start two multi-threaded runs side by side with
@@ -38,10 +38,10 @@ struct Common {
     #[arg(long)]
     no_bind: bool,
     /// Pair-list skin (length).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
     skin: Option<f64>,
     /// Cell edge of the neighbour grid (length; raised to 2 r_max + skin).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = non_negative)]
     cell: Option<f64>,
 }
 
@@ -58,7 +58,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// A save every N steps (default: the case's `run.save_every`).
-        #[arg(long)]
+        #[arg(long, value_parser = count::<u64>)]
         save_every: Option<u64>,
         /// Write a checkpoint every N steps (0 = never).
         #[arg(long, default_value_t = 0)]
@@ -80,19 +80,19 @@ enum Command {
         /// Last save (default: the last).
         #[arg(long)]
         to: Option<u64>,
-        #[arg(long, default_value_t = 100)]
+        #[arg(long, default_value_t = 100, value_parser = count::<usize>)]
         slices: usize,
         #[arg(long, value_enum, default_value_t = KernelChoice::Heaviside)]
         kernel: KernelChoice,
         /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = positive)]
         width: Option<f64>,
         /// Case file telling which particles are walls and the density (default: the
         /// benchmark's, ids 1-480 walls, density 1).
         #[arg(long)]
         case: Option<PathBuf>,
         /// Blocks of saves for the standard errors.
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = count::<usize>)]
         blocks: usize,
     },
     /// Time verdem against the installed LAMMPS and LIGGGHTS on the same case and state.
@@ -102,19 +102,19 @@ enum Command {
         /// State to start from (default: MercuryDPM's developed state).
         #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
         from: PathBuf,
-        #[arg(long, default_value_t = 20_000)]
+        #[arg(long, default_value_t = 20_000, value_parser = count::<u64>)]
         steps: u64,
         /// verdem thread counts.
-        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
         threads: Vec<usize>,
         /// Peers to run (none: --peers '').
         #[arg(long, value_delimiter = ',', default_value = "lammps,liggghts")]
         peers: Vec<String>,
         /// MPI ranks for the peers.
-        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
         np: Vec<usize>,
         /// Alternating rounds.
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 3, value_parser = count::<usize>)]
         rounds: usize,
         /// Skip the ceiling rows: two independent 1-thread verdem runs at once, which measures
         /// what this machine gives two jobs that share nothing, and the same two runs waiting
@@ -172,13 +172,13 @@ enum Command {
         /// State to start from.
         #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
         from: PathBuf,
-        #[arg(long, default_value_t = 20000)]
+        #[arg(long, default_value_t = 20000, value_parser = count::<u64>)]
         steps: u64,
         /// A save every N steps.
-        #[arg(long, default_value_t = 2000)]
+        #[arg(long, default_value_t = 2000, value_parser = count::<u64>)]
         every: u64,
         /// MPI ranks of the peer (and verdem's threads).
-        #[arg(long, default_value_t = 2)]
+        #[arg(long, default_value_t = 2, value_parser = count::<usize>)]
         np: usize,
         #[arg(long, default_value = "out/cross")]
         out: PathBuf,
@@ -198,10 +198,10 @@ enum Command {
         #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
         from: PathBuf,
         /// Simulated time of every variant (time units).
-        #[arg(long, default_value_t = 20.0)]
+        #[arg(long, default_value_t = 20.0, allow_negative_numbers = true, value_parser = positive)]
         time: f64,
         /// Saves of every variant (all are coarse-grained).
-        #[arg(long, default_value_t = 40)]
+        #[arg(long, default_value_t = 40, value_parser = count::<u64>)]
         saves: u64,
         #[arg(long, default_value = "out/tradeoff")]
         out: PathBuf,
@@ -238,6 +238,38 @@ fn main() {
     if let Err(e) = real_main() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
+    }
+}
+
+/// A count of one or more (threads, ranks, rounds, slices, blocks, steps between saves).
+fn count<T: std::str::FromStr<Err = std::num::ParseIntError> + PartialOrd + From<u8>>(
+    s: &str,
+) -> Result<T, String> {
+    let v: T = s.parse().map_err(|e| format!("{e}"))?;
+    if v >= T::from(1) {
+        Ok(v)
+    } else {
+        Err(format!("must be 1 or more, got {s}"))
+    }
+}
+
+/// A length or time that must be positive and finite.
+fn positive(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be positive and finite, got {s}"))
+    }
+}
+
+/// A length that must be zero or positive, and finite.
+fn non_negative(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be zero or positive and finite, got {s}"))
     }
 }
 
@@ -293,7 +325,7 @@ fn real_main() -> anyhow::Result<()> {
             }
             let opts = RunOptions {
                 end_step: steps.unwrap_or(case.run.steps),
-                save_every: save_every.unwrap_or(case.run.save_every).max(1),
+                save_every: save_every.unwrap_or(case.run.save_every),
                 checkpoint_every,
                 out_dir: out.unwrap_or_else(|| PathBuf::from("out").join(&case.name)),
                 name: case.name.clone(),

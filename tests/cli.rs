@@ -1,0 +1,107 @@
+//! Bad values on the command line are refused with the option named, before any work.
+
+use std::process::Command;
+
+/// Runs `verdem ARGS` and returns its exit success and standard error.
+fn verdem(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(args)
+        .output()
+        .expect("verdem runs");
+    (out.status.success(), String::from_utf8(out.stderr).unwrap())
+}
+
+#[test]
+fn out_of_range_options_are_refused_with_the_option_named() {
+    let case = "cases/shear_flow_quick.toml";
+    let refused = [
+        (
+            vec!["run", case, "--threads", "0"],
+            "'--threads <THREADS>'",
+            "1 or more",
+        ),
+        (
+            vec!["run", case, "--save-every", "0"],
+            "'--save-every <SAVE_EVERY>'",
+            "1 or more",
+        ),
+        (
+            vec!["run", case, "--skin", "-1"],
+            "'--skin <SKIN>'",
+            "positive and finite",
+        ),
+        (
+            vec!["run", case, "--skin", "nan"],
+            "'--skin <SKIN>'",
+            "positive and finite",
+        ),
+        (
+            vec!["hash", case, "--steps", "1", "--cell", "inf"],
+            "'--cell <CELL>'",
+            "finite",
+        ),
+        (
+            vec!["bench", "--threads", "1,0"],
+            "'--threads <THREADS>'",
+            "1 or more",
+        ),
+        (
+            vec!["bench", "--rounds", "0"],
+            "'--rounds <ROUNDS>'",
+            "1 or more",
+        ),
+        (
+            vec!["cg", "out/none", "--slices", "0"],
+            "'--slices <SLICES>'",
+            "1 or more",
+        ),
+        (
+            vec!["cg", "out/none", "--width", "0"],
+            "'--width <WIDTH>'",
+            "positive",
+        ),
+        (
+            vec!["tradeoff", "--time", "-3"],
+            "'--time <TIME>'",
+            "positive",
+        ),
+        (
+            vec!["cross", "lammps", "--np", "0"],
+            "'--np <NP>'",
+            "1 or more",
+        ),
+    ];
+    for (args, option, why) in refused {
+        let (ok, err) = verdem(&args);
+        assert!(!ok, "{args:?} was accepted");
+        assert!(
+            err.contains("invalid value") && err.contains(option) && err.contains(why),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+/// The smallest allowed values pass the parser (the run then ends at once).
+#[test]
+fn the_smallest_allowed_values_are_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let args = [
+        "run",
+        "cases/shear_flow_quick.toml",
+        "--steps",
+        "2",
+        "--threads",
+        "1",
+        "--save-every",
+        "1",
+        "--cell",
+        "0",
+        "--quiet",
+        "--out",
+        out,
+    ];
+    let (ok, err) = verdem(&args);
+    assert!(ok, "{err}");
+    assert!(dir.path().join("shear_flow_quick.data.0002").exists());
+}
