@@ -258,15 +258,28 @@ impl Case {
     /// Parses and validates case text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Case, CaseError> {
         let case: Case = toml::from_str(text).map_err(|e| {
-            let line = e
+            let mut line = e
                 .span()
                 .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
                 .unwrap_or(0);
+            let mut field = field_on_line(text, line);
+            let msg = e.message().trim().to_string();
+            // A tagged table (`[scene]`) is read whole, and its error points at the header:
+            // find the unknown key in it.
+            let unknown = msg
+                .strip_prefix("unknown field `")
+                .and_then(|m| m.split('`').next());
+            if let (Some(key), Some(table)) = (unknown, table_header(text_line(text, line))) {
+                let at = locate(text, &table, key);
+                if at != line {
+                    (line, field) = (at, format!("{table}.{key}"));
+                }
+            }
             CaseError {
                 file: file.into(),
                 line,
-                field: "-".into(),
-                msg: e.message().trim().to_string(),
+                field,
+                msg,
             }
         })?;
         case.validate(text, file)?;
@@ -466,14 +479,8 @@ fn locate(text: &str, table: &str, key: &str) -> usize {
     let mut header = 0;
     for (n, line) in text.lines().enumerate() {
         let l = line.trim();
-        if let Some(rest) = l.strip_prefix('[') {
-            current = rest
-                .trim_start_matches('[')
-                .split(']')
-                .next()
-                .unwrap_or("")
-                .trim()
-                .to_string();
+        if let Some(name) = table_header(l) {
+            current = name;
             if current == table {
                 header = n + 1;
             }
@@ -488,6 +495,44 @@ fn locate(text: &str, table: &str, key: &str) -> usize {
         }
     }
     header
+}
+
+/// The table a header line `[name]` or `[[name]]` opens.
+fn table_header(line: &str) -> Option<String> {
+    let rest = line.strip_prefix('[')?;
+    Some(
+        rest.trim_start_matches('[')
+            .split(']')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string(),
+    )
+}
+
+/// Line `line` (1-based) of `text`, trimmed; empty past the end.
+fn text_line(text: &str, line: usize) -> &str {
+    text.lines().nth(line.wrapping_sub(1)).unwrap_or("").trim()
+}
+
+/// The dotted name of what line `line` (1-based) of `text` holds: `table.key` for a key, the
+/// table for a header line, "-" for anything else.
+fn field_on_line(text: &str, line: usize) -> String {
+    let mut table = String::new();
+    for l in text.lines().take(line.saturating_sub(1)) {
+        if let Some(name) = table_header(l.trim()) {
+            table = name;
+        }
+    }
+    let l = text_line(text, line);
+    if let Some(name) = table_header(l) {
+        return name;
+    }
+    match l.split_once('=') {
+        Some((k, _)) if table.is_empty() => k.trim().to_string(),
+        Some((k, _)) => format!("{table}.{}", k.trim()),
+        None => "-".into(),
+    }
 }
 
 #[cfg(test)]
@@ -524,7 +569,24 @@ mod tests {
         let e = Case::parse(&bad, "bad.toml").unwrap_err();
         let line = bad.lines().position(|l| l.starts_with("friction")).unwrap() + 1;
         assert_eq!(e.line, line);
+        assert_eq!(e.field, "contact.friction");
         assert!(e.msg.contains("unknown field `friction`"), "{e}");
+    }
+
+    #[test]
+    fn an_unknown_key_of_the_scene_names_its_line() {
+        let bad = CASE.replace("top_vx = 1.0", "top_vx = 1.0\nbogus = 1");
+        let e = Case::parse(&bad, "bad.toml").unwrap_err();
+        let line = bad.lines().position(|l| l.starts_with("bogus")).unwrap() + 1;
+        assert_eq!((e.line, e.field.as_str()), (line, "scene.bogus"), "{e}");
+    }
+
+    #[test]
+    fn a_value_of_the_wrong_type_names_its_field() {
+        let bad = CASE.replace("skin = 0.1", "skin = \"wide\"");
+        let e = Case::parse(&bad, "bad.toml").unwrap_err();
+        let line = bad.lines().position(|l| l.starts_with("skin =")).unwrap() + 1;
+        assert_eq!((e.line, e.field.as_str()), (line, "neighbor.skin"), "{e}");
     }
 
     #[test]

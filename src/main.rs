@@ -323,8 +323,20 @@ fn real_main() -> anyhow::Result<()> {
                     engine.core().time
                 );
             }
+            let end_step = steps.unwrap_or(case.run.steps);
+            if end_step < engine.core().step {
+                anyhow::bail!(
+                    "the run would end at step {end_step} ({}), before the checkpoint's step {}",
+                    if steps.is_some() {
+                        "--steps"
+                    } else {
+                        "the case's run.steps"
+                    },
+                    engine.core().step
+                );
+            }
             let opts = RunOptions {
-                end_step: steps.unwrap_or(case.run.steps),
+                end_step,
                 save_every: save_every.unwrap_or(case.run.save_every),
                 checkpoint_every,
                 out_dir: out.unwrap_or_else(|| PathBuf::from("out").join(&case.name)),
@@ -334,7 +346,6 @@ fn real_main() -> anyhow::Result<()> {
                 write_saves: true,
             };
             let s = run::run(engine.as_mut(), &opts, resume.is_some())?;
-            let full = 2e8 / s.rate();
             println!(
                 "done: step {} t = {} saves {} in {}",
                 s.step,
@@ -342,13 +353,17 @@ fn real_main() -> anyhow::Result<()> {
                 s.saves,
                 opts.out_dir.display()
             );
-            println!(
-                "rate: {:.0} steps/s on {} thread(s) ({:.1} s); the full 2e8-step benchmark would take {:.2} h at this rate",
-                s.rate(),
-                engine.core().threads,
-                s.seconds,
-                full / 3600.0
-            );
+            if s.steps_run > 0 {
+                println!(
+                    "rate: {:.0} steps/s on {} thread(s) ({:.1} s); the full 2e8-step benchmark would take {:.2} h at this rate",
+                    s.rate(),
+                    engine.core().threads,
+                    s.seconds,
+                    2e8 / s.rate() / 3600.0
+                );
+            } else {
+                println!("rate: no steps run");
+            }
             let st = &s.stages;
             let ms = |ns: u64| ns as f64 * 1e-6;
             println!(
@@ -500,6 +515,9 @@ fn real_main() -> anyhow::Result<()> {
             }
             if let Some(only) = only {
                 rows.retain(|r| r.case.contains(&only));
+                if rows.is_empty() {
+                    anyhow::bail!("--only {only:?}: no verification row's case contains it");
+                }
             }
             print!("{}", verdem::verify::table(&rows));
             let passed = rows.iter().filter(|r| r.pass).count();

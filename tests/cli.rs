@@ -105,3 +105,48 @@ fn the_smallest_allowed_values_are_accepted() {
     assert!(ok, "{err}");
     assert!(dir.path().join("shear_flow_quick.data.0002").exists());
 }
+
+/// Resuming a checkpoint with an end before it is refused, naming both steps; ending at it runs
+/// nothing and says so, without a rate.
+#[test]
+fn a_resume_that_would_end_before_its_checkpoint_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let case = "cases/shear_flow_quick.toml";
+    let common = ["--save-every", "100", "--quiet", "--out", out];
+    let (ok, err) = verdem(
+        &[
+            &["run", case, "--steps", "4", "--checkpoint-every", "4"],
+            &common[..],
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let ck = dir.path().join("shear_flow_quick.checkpoint");
+    let ck = ck.to_str().unwrap();
+    let (ok, err) = verdem(&[&["run", case, "--steps", "2", "--resume", ck], &common[..]].concat());
+    assert!(!ok);
+    assert!(
+        err.contains("the run would end at step 2 (--steps), before the checkpoint's step 4"),
+        "{err}"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args([&["run", case, "--steps", "4", "--resume", ck], &common[..]].concat())
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        out.status.success() && text.contains("rate: no steps run"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_verify_filter_that_matches_nothing_is_an_error() {
+    let (ok, err) = verdem(&["verify", "--only", "no such case"]);
+    assert!(!ok);
+    assert!(
+        err.contains("no verification row's case contains it"),
+        "{err}"
+    );
+}

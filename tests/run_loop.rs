@@ -60,7 +60,7 @@ fn resumed_run_matches_uninterrupted_run_bit_for_bit() {
     assert_eq!(diag(dir.path()), diag(full_dir.path()));
 }
 
-/// A checkpoint of another case is refused.
+/// A checkpoint of another case, a truncated one and a file that is none are refused.
 #[test]
 fn checkpoint_of_another_case_is_refused() {
     let case = quick_case();
@@ -75,6 +75,23 @@ fn checkpoint_of_another_case_is_refused() {
     let mut other = engine(&case, None, Overrides::default());
     let err = verdem::checkpoint::read(&p, other.core_mut(), "other:3480").unwrap_err();
     assert!(err.to_string().contains("checkpoint of case"), "{err}");
+    // a truncated checkpoint says where it ends; a short foreign file is no checkpoint
+    let bytes = std::fs::read(&p).unwrap();
+    let cut = dir.path().join("cut.checkpoint");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let err = verdem::checkpoint::read(&cut, other.core_mut(), "q:3480").unwrap_err();
+    assert!(
+        err.to_string().contains("checkpoint truncated at byte"),
+        "{err}"
+    );
+    for junk in [&b"garbage"[..], b"garbage and more"] {
+        std::fs::write(&cut, junk).unwrap();
+        let err = verdem::checkpoint::read(&cut, other.core_mut(), "q:3480").unwrap_err();
+        assert!(
+            err.to_string().ends_with("not a verdem checkpoint"),
+            "{err}"
+        );
+    }
 }
 
 /// Saves are MercuryCG files that read back to the state that was written, bit for bit, with

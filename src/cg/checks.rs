@@ -265,8 +265,20 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
 pub fn report(p: &Profiles, checks: &[Check]) -> String {
     let block_len = p.saves.len() as f64 / p.blocks as f64;
     let tau = p.tau_shear.max(p.tau_energy);
+    let independence = if tau.is_nan() {
+        "integrated autocorrelation time not estimated (fewer than 4 saves)".to_string()
+    } else {
+        let independent = block_len >= 2.0 * tau;
+        format!(
+            "integrated autocorrelation time {:.2} saves (shear), {:.2} (kinetic energy): blocks {} independent (block length {} 2 tau)",
+            p.tau_shear,
+            p.tau_energy,
+            if independent { "are" } else { "are NOT" },
+            if independent { ">=" } else { "<" },
+        )
+    };
     let mut s = format!(
-        "saves {}..{} ({}), kernel {:?}, {} slices, {} blocks of {:.1} saves; integrated autocorrelation time {:.2} saves (shear), {:.2} (kinetic energy): blocks {} independent (block length {} 2 tau)\n",
+        "saves {}..{} ({}), kernel {:?}, {} slices, {} blocks of {:.1} saves; {independence}\n",
         p.saves.first().unwrap_or(&0),
         p.saves.last().unwrap_or(&0),
         p.saves.len(),
@@ -274,10 +286,6 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
         p.grid.n,
         p.blocks,
         block_len,
-        p.tau_shear,
-        p.tau_energy,
-        if block_len >= 2.0 * tau { "are" } else { "are NOT" },
-        if block_len >= 2.0 * tau { ">=" } else { "<" },
     );
     for c in checks {
         let verdict = match c.pass {
