@@ -563,30 +563,38 @@ mod tests {
         );
     }
 
+    /// An unknown key, one in the tagged `[scene]` table, and a value of the wrong type.
     #[test]
-    fn unknown_field_is_rejected_with_its_line() {
-        let bad = CASE.replace("mu = 0.3", "mu = 0.3\nfriction = 0.5");
-        let e = Case::parse(&bad, "bad.toml").unwrap_err();
-        let line = bad.lines().position(|l| l.starts_with("friction")).unwrap() + 1;
-        assert_eq!(e.line, line);
-        assert_eq!(e.field, "contact.friction");
-        assert!(e.msg.contains("unknown field `friction`"), "{e}");
-    }
-
-    #[test]
-    fn an_unknown_key_of_the_scene_names_its_line() {
-        let bad = CASE.replace("top_vx = 1.0", "top_vx = 1.0\nbogus = 1");
-        let e = Case::parse(&bad, "bad.toml").unwrap_err();
-        let line = bad.lines().position(|l| l.starts_with("bogus")).unwrap() + 1;
-        assert_eq!((e.line, e.field.as_str()), (line, "scene.bogus"), "{e}");
-    }
-
-    #[test]
-    fn a_value_of_the_wrong_type_names_its_field() {
-        let bad = CASE.replace("skin = 0.1", "skin = \"wide\"");
-        let e = Case::parse(&bad, "bad.toml").unwrap_err();
-        let line = bad.lines().position(|l| l.starts_with("skin =")).unwrap() + 1;
-        assert_eq!((e.line, e.field.as_str()), (line, "neighbor.skin"), "{e}");
+    fn a_parse_error_names_its_line_and_field() {
+        for (from, to, at, field, msg) in [
+            (
+                "mu = 0.3",
+                "mu = 0.3\nfriction = 0.5",
+                "friction",
+                "contact.friction",
+                "unknown field `friction`",
+            ),
+            (
+                "top_vx = 1.0",
+                "top_vx = 1.0\nbogus = 1",
+                "bogus",
+                "scene.bogus",
+                "unknown field `bogus`",
+            ),
+            (
+                "skin = 0.1",
+                "skin = \"wide\"",
+                "skin =",
+                "neighbor.skin",
+                "invalid type",
+            ),
+        ] {
+            let bad = CASE.replace(from, to);
+            let e = Case::parse(&bad, "bad.toml").unwrap_err();
+            let line = bad.lines().position(|l| l.starts_with(at)).unwrap() + 1;
+            assert_eq!((e.line, e.field.as_str()), (line, field), "{e}");
+            assert!(e.msg.contains(msg), "{e}");
+        }
     }
 
     #[test]
