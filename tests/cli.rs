@@ -121,3 +121,27 @@ fn a_verify_filter_that_matches_nothing_is_an_error() {
         "{err}"
     );
 }
+
+/// Only the bumpy-shear scene is coarse-grained into the benchmark's profiles and checks at the
+/// end of a run: a two-sphere collision has no mid-plane, walls or kinetic theory to check.
+#[test]
+fn a_run_of_another_scene_writes_no_shear_profiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let case = "cases/verify/binary_collision.toml";
+    let args = ["run", case, "--steps", "10", "--quiet", "--out", out];
+    let run = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = String::from_utf8(run.stdout).unwrap();
+    assert!(run.status.success(), "{text}");
+    assert!(text.contains("profiles: none"), "{text}");
+    assert!(!text.contains("PASS") && !text.contains("FAIL"), "{text}");
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().any(|n| n.ends_with(".data.0000")), "{names:?}");
+    assert!(!names.iter().any(|n| n.contains("profiles")), "{names:?}");
+}
