@@ -389,12 +389,6 @@ fn real_main() -> anyhow::Result<()> {
             verdem::io::atomic::write(&p, summary.as_bytes())
                 .with_context(|| p.display().to_string())?;
             let shear = matches!(case.scene, verdem::case::Scene::BumpyShear { .. });
-            if s.saves > 0 && !shear {
-                println!(
-                    "profiles: none (the z-profiles and their checks describe the bumpy-shear \
-                     scene; `verdem cg` coarse-grains these saves all the same)"
-                );
-            }
             if s.saves > 0 && shear {
                 let (_, report) =
                     cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
@@ -405,6 +399,11 @@ fn real_main() -> anyhow::Result<()> {
                         .display()
                 );
                 print!("{report}");
+            } else if s.saves > 0 {
+                println!(
+                    "profiles: none (the z-profiles and their checks describe the bumpy-shear \
+                     scene; `verdem cg` coarse-grains these saves all the same)"
+                );
             }
         }
         Command::Cg {

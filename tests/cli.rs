@@ -1,14 +1,26 @@
-//! Bad values on the command line are refused with the option named, before any work.
+//! The command line: bad values are refused with the option named, before any work; what a
+//! run prints and writes at its edges (a resume, a scene other than the shear cell).
 
 use std::process::Command;
 
-/// Runs `verdem ARGS` and returns its exit success and standard error.
-fn verdem(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
+/// What a run of `verdem` ended with.
+struct Outcome {
+    ok: bool,
+    out: String,
+    err: String,
+}
+
+/// Runs `verdem ARGS`.
+fn verdem(args: &[&str]) -> Outcome {
+    let o = Command::new(env!("CARGO_BIN_EXE_verdem"))
         .args(args)
         .output()
         .expect("verdem runs");
-    (out.status.success(), String::from_utf8(out.stderr).unwrap())
+    Outcome {
+        ok: o.status.success(),
+        out: String::from_utf8(o.stdout).unwrap(),
+        err: String::from_utf8(o.stderr).unwrap(),
+    }
 }
 
 #[test]
@@ -43,7 +55,7 @@ fn out_of_range_options_are_refused_with_the_option_named() {
         // clap names the option as `'--save-every <SAVE_EVERY>'`
         let flag = args.iter().rev().find(|a| a.starts_with("--")).unwrap();
         let option = format!("'{flag} <{}>'", flag[2..].replace('-', "_").to_uppercase());
-        let (ok, err) = verdem(&args);
+        let Outcome { ok, err, .. } = verdem(&args);
         assert!(!ok, "{line} was accepted");
         assert!(
             err.contains("invalid value") && err.contains(&option) && err.contains(why),
@@ -72,7 +84,7 @@ fn the_smallest_allowed_values_are_accepted() {
         "--out",
         out,
     ];
-    let (ok, err) = verdem(&args);
+    let Outcome { ok, err, .. } = verdem(&args);
     assert!(ok, "{err}");
     assert!(dir.path().join("shear_flow_quick.data.0002").exists());
 }
@@ -85,7 +97,7 @@ fn a_resume_that_would_end_before_its_checkpoint_is_refused() {
     let out = dir.path().to_str().unwrap();
     let case = "cases/shear_flow_quick.toml";
     let common = ["--save-every", "100", "--quiet", "--out", out];
-    let (ok, err) = verdem(
+    let Outcome { ok, err, .. } = verdem(
         &[
             &["run", case, "--steps", "4", "--checkpoint-every", "4"],
             &common[..],
@@ -95,26 +107,24 @@ fn a_resume_that_would_end_before_its_checkpoint_is_refused() {
     assert!(ok, "{err}");
     let ck = dir.path().join("shear_flow_quick.checkpoint");
     let ck = ck.to_str().unwrap();
-    let (ok, err) = verdem(&[&["run", case, "--steps", "2", "--resume", ck], &common[..]].concat());
+    let Outcome { ok, err, .. } =
+        verdem(&[&["run", case, "--steps", "2", "--resume", ck], &common[..]].concat());
     assert!(!ok);
     assert!(
         err.contains("the run would end at step 2 (--steps), before the checkpoint's step 4"),
         "{err}"
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
-        .args([&["run", case, "--steps", "4", "--resume", ck], &common[..]].concat())
-        .output()
-        .unwrap();
-    let text = String::from_utf8(out.stdout).unwrap();
+    let at_it = verdem(&[&["run", case, "--steps", "4", "--resume", ck], &common[..]].concat());
     assert!(
-        out.status.success() && text.contains("rate: no steps run"),
-        "{text}"
+        at_it.ok && at_it.out.contains("rate: no steps run"),
+        "{}",
+        at_it.out
     );
 }
 
 #[test]
 fn a_verify_filter_that_matches_nothing_is_an_error() {
-    let (ok, err) = verdem(&["verify", "--only", "no such case"]);
+    let Outcome { ok, err, .. } = verdem(&["verify", "--only", "no such case"]);
     assert!(!ok);
     assert!(
         err.contains("no verification row's case contains it"),
@@ -130,12 +140,8 @@ fn a_run_of_another_scene_writes_no_shear_profiles() {
     let out = dir.path().to_str().unwrap();
     let case = "cases/verify/binary_collision.toml";
     let args = ["run", case, "--steps", "10", "--quiet", "--out", out];
-    let run = Command::new(env!("CARGO_BIN_EXE_verdem"))
-        .args(args)
-        .output()
-        .unwrap();
-    let text = String::from_utf8(run.stdout).unwrap();
-    assert!(run.status.success(), "{text}");
+    let Outcome { ok, out: text, .. } = verdem(&args);
+    assert!(ok, "{text}");
     assert!(text.contains("profiles: none"), "{text}");
     assert!(!text.contains("PASS") && !text.contains("FAIL"), "{text}");
     let names: Vec<String> = std::fs::read_dir(dir.path())
