@@ -1,6 +1,8 @@
 //! The `verdem` command line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
@@ -234,11 +236,75 @@ enum Command {
     },
 }
 
+/// Exit status of a run stopped by a signal after writing its checkpoint (128 + SIGINT, as a
+/// shell reports a process that SIGINT ended).
+const EXIT_INTERRUPTED: i32 = 130;
+
 fn main() {
-    if let Err(e) = real_main() {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+    match real_main() {
+        Ok(Finished::Done) => {}
+        Ok(Finished::Interrupted) => std::process::exit(EXIT_INTERRUPTED),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::exit(1);
+        }
     }
+}
+
+/// How a command ended, when it did not fail.
+enum Finished {
+    Done,
+    /// A run stopped by a signal, its checkpoint written.
+    Interrupted,
+}
+
+/// A flag raised by SIGINT, SIGTERM or SIGHUP (ctrlc's `termination` feature): a run then stops
+/// at the end of its block of steps and writes a checkpoint. A second signal ends the process at
+/// once; every file it has written is whole (written atomically) all the same.
+fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(EXIT_INTERRUPTED);
+        }
+        eprintln!(
+            "\nstopping: writing a checkpoint at the end of the steps under way \
+             (a second signal stops at once, without it)"
+        );
+    })
+    .context("cannot install the signal handler")?;
+    Ok(stop)
+}
+
+/// This process's command line with `--resume CHECKPOINT` in place of any `--resume` it had,
+/// quoted for a POSIX shell.
+fn resume_command(checkpoint: &Path) -> String {
+    let mut args: Vec<String> = Vec::new();
+    let mut skip = false;
+    for a in std::env::args() {
+        if std::mem::take(&mut skip) {
+            continue;
+        }
+        if a == "--resume" {
+            skip = true;
+        } else if !a.starts_with("--resume=") {
+            args.push(a);
+        }
+    }
+    args.push("--resume".into());
+    args.push(checkpoint.display().to_string());
+    let quote = |a: &String| {
+        let plain = a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+".contains(c));
+        if plain && !a.is_empty() {
+            a.clone()
+        } else {
+            format!("'{}'", a.replace('\'', r"'\''"))
+        }
+    };
+    args.iter().map(quote).collect::<Vec<_>>().join(" ")
 }
 
 /// A count of one or more (threads, ranks, rounds, slices, blocks, steps between saves).
@@ -301,7 +367,7 @@ fn print_contact_summary(case: &Case) {
     println!("dt = {dt:e}");
 }
 
-fn real_main() -> anyhow::Result<()> {
+fn real_main() -> anyhow::Result<Finished> {
     match Cli::parse().command {
         Command::Run {
             common,
@@ -344,8 +410,21 @@ fn real_main() -> anyhow::Result<()> {
                 tag,
                 progress: !quiet,
                 write_saves: true,
+                stop: Some(stop_on_signal()?),
             };
             let s = run::run(engine.as_mut(), &opts, resume.is_some())?;
+            if s.interrupted {
+                let ck = run::checkpoint_path(&opts.out_dir, &opts.name);
+                println!(
+                    "interrupted at step {} (t = {}) after {} saves; checkpoint {}",
+                    s.step,
+                    s.time,
+                    s.saves,
+                    ck.display()
+                );
+                println!("continue with: {}", resume_command(&ck));
+                return Ok(Finished::Interrupted);
+            }
             println!(
                 "done: step {} t = {} saves {} in {}",
                 s.step,
@@ -632,5 +711,5 @@ fn real_main() -> anyhow::Result<()> {
             println!("{}", hash::state_hash(&engine.core().snapshot()));
         }
     }
-    Ok(())
+    Ok(Finished::Done)
 }

@@ -2,6 +2,8 @@
 //! the diagnostics table, report progress, and summarise the run.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -26,6 +28,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Write `.data`/`.fstat` saves and diagnostics (false for timing runs).
     pub write_saves: bool,
+    /// A request to stop (set by a signal handler): the run stops at the end of the block of
+    /// steps under way (at most 2000), writes a checkpoint there and returns.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// What a finished run reports.
@@ -39,6 +44,8 @@ pub struct RunSummary {
     pub seconds: f64,
     pub stages: StageTimes,
     pub saves: u64,
+    /// The run stopped before `end_step` on request, with a checkpoint at `step`.
+    pub interrupted: bool,
 }
 
 impl RunSummary {
@@ -80,6 +87,7 @@ pub fn run(
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
+    let mut interrupted = false;
     loop {
         let core = engine.core();
         let step = core.step;
@@ -94,15 +102,19 @@ pub fn run(
             && step.is_multiple_of(opts.checkpoint_every)
             && step != start_step
         {
-            crate::checkpoint::write(
-                &checkpoint_path(&opts.out_dir, &opts.name),
-                &engine.core().snapshot(),
-                engine.core().dt,
-                &opts.tag,
-            )?;
+            write_checkpoint(engine, opts)?;
         }
         first = false;
         if step >= opts.end_step {
+            break;
+        }
+        if opts
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+        {
+            write_checkpoint(engine, opts)?;
+            interrupted = true;
             break;
         }
         let mut next = opts.end_step.min(step + 2000);
@@ -130,7 +142,17 @@ pub fn run(
         seconds: t0.elapsed().as_secs_f64(),
         stages: core.times,
         saves,
+        interrupted,
     })
+}
+
+fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()> {
+    crate::checkpoint::write(
+        &checkpoint_path(&opts.out_dir, &opts.name),
+        &engine.core().snapshot(),
+        engine.core().dt,
+        &opts.tag,
+    )
 }
 
 fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {

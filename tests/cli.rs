@@ -151,3 +151,89 @@ fn a_run_of_another_scene_writes_no_shear_profiles() {
     assert!(names.iter().any(|n| n.ends_with(".data.0000")), "{names:?}");
     assert!(!names.iter().any(|n| n.contains("profiles")), "{names:?}");
 }
+
+/// A run stopped by SIGTERM (a batch scheduler's time limit) or SIGINT (Ctrl-C) writes a
+/// checkpoint where it stops, keeps its saves, exits with 130 and prints the command that
+/// continues it; that command ends in the bits and files of a run never stopped.
+#[test]
+fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
+    let case = "cases/shear_flow_quick.toml";
+    let state = "../shared/data/states/mercury_t143.85.data";
+    let run_args = |out: &str| {
+        [
+            "run",
+            case,
+            "--init",
+            state,
+            "--steps",
+            "20000",
+            "--save-every",
+            "500",
+            "--threads",
+            "1",
+            "--quiet",
+            "--out",
+            out,
+        ]
+        .map(String::from)
+    };
+    let stopped = tempfile::tempdir().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(run_args(stopped.path().to_str().unwrap()))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("verdem runs");
+    let first_save = stopped.path().join("shear_flow_quick.data.0001");
+    while !first_save.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before its 1st save"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    // SAFETY: kill(2) with the pid of our own live child and a valid signal number.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let o = child.wait_with_output().unwrap();
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(o.status.code(), Some(130), "{text}");
+    let step: u64 = text
+        .split("interrupted at step ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no step in {text}"));
+    assert!((1000..20000).contains(&step), "{text}");
+    assert!(stopped.path().join("shear_flow_quick.checkpoint").exists());
+    let continued = text
+        .lines()
+        .find_map(|l| l.strip_prefix("continue with: "))
+        .unwrap_or_else(|| panic!("no command in {text}"));
+    // The printed command starts with the program; its other words are plain paths here.
+    let words: Vec<&str> = continued.split(' ').skip(1).collect();
+    assert!(continued.contains("--resume"), "{continued}");
+    let resumed = verdem(&words);
+    assert!(resumed.ok, "{}", resumed.err);
+    assert!(resumed.out.contains(&format!("resumed at step {step}")));
+
+    let straight_dir = tempfile::tempdir().unwrap();
+    let straight_args = run_args(straight_dir.path().to_str().unwrap());
+    let straight = verdem(&straight_args.each_ref().map(String::as_str));
+    assert!(straight.ok, "{}", straight.err);
+    let hash = |t: &str| {
+        t.lines()
+            .find(|l| l.starts_with("state hash:"))
+            .map(String::from)
+    };
+    assert!(hash(&straight.out).is_some());
+    assert_eq!(hash(&resumed.out), hash(&straight.out));
+    for name in [
+        "shear_flow_quick.data.0040",
+        "shear_flow_quick.fstat.0003",
+        "shear_flow_quick.diagnostics.csv",
+    ] {
+        let a = std::fs::read(stopped.path().join(name)).unwrap();
+        let b = std::fs::read(straight_dir.path().join(name)).unwrap();
+        assert!(a == b, "{name} differs");
+    }
+}

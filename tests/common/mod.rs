@@ -76,6 +76,7 @@ pub fn run_with_saves(
         tag: name.into(),
         progress: false,
         write_saves: true,
+        stop: None,
     };
     verdem::run::run(engine, &opts, false).expect("run")
 }
