@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::Context;
+use anyhow::{bail, Context};
 
 use crate::diagnostics::{Diagnostics, CSV_HEADER};
 use crate::io::{atomic, mercury};
@@ -80,7 +80,7 @@ pub fn run(
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
     if opts.write_saves {
-        prepare_diagnostics(&diag, engine.core().step, resumed)?;
+        prepare_diagnostics(&diag, engine.core().step, opts.save_every, resumed)?;
     }
     let start_step = engine.core().step;
     let bar = progress_bar(opts, start_step);
@@ -168,17 +168,41 @@ fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Re
         .with_context(|| format!("{}: cannot append", diag.display()))
 }
 
-/// A fresh run starts a new table; a resumed one keeps the rows up to its step.
-fn prepare_diagnostics(path: &Path, step: u64, resumed: bool) -> anyhow::Result<()> {
+/// A fresh run starts a new table; a resumed one keeps the rows up to its step, which must have
+/// been saved every `save_every` steps as this run saves (else its saves would be numbered
+/// differently from those already in the folder).
+fn prepare_diagnostics(
+    path: &Path,
+    step: u64,
+    save_every: u64,
+    resumed: bool,
+) -> anyhow::Result<()> {
     let mut text = String::from(CSV_HEADER);
     if resumed {
         let old = std::fs::read_to_string(path).unwrap_or_default();
-        for line in old.lines().skip(1) {
-            let row_step: Option<u64> = line.split(',').nth(1).and_then(|s| s.parse().ok());
-            if row_step.is_some_and(|s| s <= step) {
-                text.push_str(line);
-                text.push('\n');
+        for (n, line) in old.lines().enumerate().skip(1) {
+            let mut fields = line.split(',').map(|f| f.parse::<u64>().ok());
+            let (Some(save), Some(row_step)) = (fields.next().flatten(), fields.next().flatten())
+            else {
+                continue;
+            };
+            if row_step > step {
+                continue;
             }
+            if save * save_every != row_step {
+                let written_every = match row_step.checked_div(save) {
+                    Some(e) if e * save == row_step => format!("--save-every {e}"),
+                    _ => "the --save-every of the run that wrote it".into(),
+                };
+                bail!(
+                    "{}:{}: save {save} is at step {row_step}, but this run saves every \
+                     {save_every} steps; resume with {written_every}",
+                    path.display(),
+                    n + 1
+                );
+            }
+            text.push_str(line);
+            text.push('\n');
         }
     }
     atomic::write(path, text.as_bytes())

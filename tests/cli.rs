@@ -122,6 +122,51 @@ fn a_resume_that_would_end_before_its_checkpoint_is_refused() {
     );
 }
 
+/// A resume that would number its saves differently from those already in the folder is
+/// refused, naming the diagnostics row and the interval that wrote them.
+#[test]
+fn a_resume_with_another_save_interval_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let case = "cases/shear_flow_quick.toml";
+    let first = ["run", case, "--steps", "4", "--save-every", "2"];
+    let Outcome { ok, err, .. } = verdem(
+        &[
+            &first[..],
+            &["--checkpoint-every", "4", "--quiet", "--out", out],
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let ck = dir.path().join("shear_flow_quick.checkpoint");
+    let resume = [
+        "run",
+        case,
+        "--steps",
+        "8",
+        "--resume",
+        ck.to_str().unwrap(),
+    ];
+    let again = |every: &str| {
+        verdem(
+            &[
+                &resume[..],
+                &["--save-every", every, "--quiet", "--out", out],
+            ]
+            .concat(),
+        )
+    };
+    let Outcome { ok, err, .. } = again("1");
+    assert!(!ok);
+    assert!(
+        err.contains("shear_flow_quick.diagnostics.csv:3: save 1 is at step 2, but this run saves every 1 steps; resume with --save-every 2"),
+        "{err}"
+    );
+    let Outcome { ok, err, .. } = again("2");
+    assert!(ok, "{err}");
+    assert!(dir.path().join("shear_flow_quick.data.0004").exists());
+}
+
 #[test]
 fn a_verify_filter_that_matches_nothing_is_an_error() {
     let Outcome { ok, err, .. } = verdem(&["verify", "--only", "no such case"]);
