@@ -432,13 +432,21 @@ fn real_main() -> anyhow::Result<Finished> {
                 s.saves,
                 opts.out_dir.display()
             );
+            let shear = matches!(case.scene, verdem::case::Scene::BumpyShear { .. });
             if s.steps_run > 0 {
+                let projection = if shear {
+                    format!(
+                        "; the full 2e8-step benchmark would take {:.2} h at this rate",
+                        2e8 / s.rate() / 3600.0
+                    )
+                } else {
+                    String::new()
+                };
                 println!(
-                    "rate: {:.0} steps/s on {} thread(s) ({:.1} s); the full 2e8-step benchmark would take {:.2} h at this rate",
+                    "rate: {:.0} steps/s on {} thread(s) ({:.1} s){projection}",
                     s.rate(),
                     engine.core().threads,
                     s.seconds,
-                    2e8 / s.rate() / 3600.0
                 );
             } else {
                 println!("rate: no steps run");
@@ -467,7 +475,6 @@ fn real_main() -> anyhow::Result<Finished> {
             let p = opts.out_dir.join(format!("{}.summary.toml", case.name));
             verdem::io::atomic::write(&p, summary.as_bytes())
                 .with_context(|| p.display().to_string())?;
-            let shear = matches!(case.scene, verdem::case::Scene::BumpyShear { .. });
             if s.saves > 0 && shear {
                 let (_, report) =
                     cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;

@@ -178,7 +178,8 @@ fn a_verify_filter_that_matches_nothing_is_an_error() {
 }
 
 /// Only the bumpy-shear scene is coarse-grained into the benchmark's profiles and checks at the
-/// end of a run: a two-sphere collision has no mid-plane, walls or kinetic theory to check.
+/// end of a run, and only its rate is projected to the benchmark's 2e8 steps: a two-sphere
+/// collision has no mid-plane, walls or kinetic theory to check.
 #[test]
 fn a_run_of_another_scene_writes_no_shear_profiles() {
     let dir = tempfile::tempdir().unwrap();
@@ -188,6 +189,7 @@ fn a_run_of_another_scene_writes_no_shear_profiles() {
     let Outcome { ok, out: text, .. } = verdem(&args);
     assert!(ok, "{text}");
     assert!(text.contains("profiles: none"), "{text}");
+    assert!(!text.contains("2e8-step benchmark"), "{text}");
     assert!(!text.contains("PASS") && !text.contains("FAIL"), "{text}");
     let names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
@@ -260,6 +262,7 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     let resumed = verdem(&words);
     assert!(resumed.ok, "{}", resumed.err);
     assert!(resumed.out.contains(&format!("resumed at step {step}")));
+    assert!(resumed.out.contains("the full 2e8-step benchmark would take"));
 
     let straight_dir = tempfile::tempdir().unwrap();
     let straight_args = run_args(straight_dir.path().to_str().unwrap());
