@@ -262,7 +262,9 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     let resumed = verdem(&words);
     assert!(resumed.ok, "{}", resumed.err);
     assert!(resumed.out.contains(&format!("resumed at step {step}")));
-    assert!(resumed.out.contains("the full 2e8-step benchmark would take"));
+    assert!(resumed
+        .out
+        .contains("the full 2e8-step benchmark would take"));
 
     let straight_dir = tempfile::tempdir().unwrap();
     let straight_args = run_args(straight_dir.path().to_str().unwrap());

@@ -14,6 +14,23 @@ pub struct Check {
     pub pass: Option<bool>,
 }
 
+/// How the name of the steadiness check starts.
+const STEADY: &str = "steady:";
+
+/// What a failed steadiness check means for the other verdicts, or `None` when it passed or was
+/// not judged.
+fn unsteady_note(checks: &[Check]) -> Option<&'static str> {
+    checks
+        .iter()
+        .any(|c| c.name.starts_with(STEADY) && c.pass == Some(false))
+        .then_some(
+            "note: the flow is not steady over these saves, and the uniformity, wall and \
+             symmetry checks judge a steady flow. From rest the shear flow is still developing \
+             at t = 144 (the quick case); coarse-grain later saves (--from) or run from a steady \
+             state (cases/shear_flow_steady.toml starts from verdem's full run).",
+        )
+}
+
 fn col(name: &str) -> usize {
     COLUMNS
         .iter()
@@ -215,7 +232,8 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             pass: judged.then_some(chi < limit),
         });
     }
-    // 5. Steadiness: no trend of the core's fluctuation energy ½ tr σ_kin across the blocks.
+    // 5. Steadiness: no trend of the core's fluctuation energy ½ tr σ_kin across the blocks
+    //    (its name starts with STEADY, which `unsteady_note` looks for).
     let energy: Vec<f64> = p
         .block_columns
         .iter()
@@ -229,7 +247,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     let (change, t) = trend(&energy);
     out.push(Check {
         name: format!(
-            "steady: core fluctuation energy density has no trend across the {} blocks",
+            "{STEADY} core fluctuation energy density has no trend across the {} blocks",
             energy.len()
         ),
         measured: format!(
@@ -298,12 +316,36 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
             c.name, c.measured, c.expected
         ));
     }
+    if let Some(note) = unsteady_note(checks) {
+        s.push_str(note);
+        s.push('\n');
+    }
     s
 }
 
 #[cfg(test)]
 mod tests {
-    use super::trend;
+    use super::{trend, unsteady_note, Check, STEADY};
+
+    #[test]
+    fn only_a_failed_steadiness_check_adds_the_note() {
+        let check = |name: &str, pass| Check {
+            name: name.into(),
+            measured: String::new(),
+            expected: String::new(),
+            pass,
+        };
+        let steady = |pass| check(&format!("{STEADY} trend"), pass);
+        let uniform = check("sigma_zz uniform", Some(false));
+        assert!(unsteady_note(&[uniform, steady(Some(false))]).is_some());
+        for pass in [Some(true), None] {
+            assert_eq!(unsteady_note(&[steady(pass)]), None);
+        }
+        assert_eq!(
+            unsteady_note(&[check("sigma_zz uniform", Some(false))]),
+            None
+        );
+    }
 
     #[test]
     fn a_trend_is_measured_against_its_scatter() {
