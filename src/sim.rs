@@ -126,7 +126,7 @@ pub struct Core {
     pub times: StageTimes,
     /// Set by the pair pass for both particles of every contact, read and cleared by the next
     /// particle pass: a particle without contacts skips the gather (its sum is exactly zero).
-    /// In the developed shear state ~12 of 3480 spheres touch at a time; scanning every free
+    /// In the developed shear state ~12 contacts join 3480 spheres at a time; scanning every free
     /// particle's pair slots instead took one thread 673 k instructions a step against 384 k
     /// (valgrind's callgrind, steps 2000 to 4000 from `mercury_t143.85`, 2026-11-23).
     touched: Vec<AtomicBool>,
