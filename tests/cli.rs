@@ -213,9 +213,9 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
             "--init",
             state,
             "--steps",
-            "20000",
+            "40000",
             "--save-every",
-            "500",
+            "1000",
             "--threads",
             "1",
             "--quiet",
@@ -250,7 +250,8 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
         .and_then(|t| t.split(' ').next())
         .and_then(|s| s.parse().ok())
         .unwrap_or_else(|| panic!("no step in {text}"));
-    assert!((1000..20000).contains(&step), "{text}");
+    // save 1 is at step 1000: the run stops there or at a later block's end, before its last
+    assert!((1000..40000).contains(&step), "{text}");
     assert!(stopped.path().join("shear_flow_quick.checkpoint").exists());
     let continued = text
         .lines()
