@@ -87,8 +87,7 @@ pub fn run(
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
-    let mut interrupted = false;
-    loop {
+    let interrupted = loop {
         let core = engine.core();
         let step = core.step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
@@ -106,7 +105,7 @@ pub fn run(
         }
         first = false;
         if step >= opts.end_step {
-            break;
+            break false;
         }
         if opts
             .stop
@@ -114,8 +113,7 @@ pub fn run(
             .is_some_and(|s| s.load(Ordering::Relaxed))
         {
             write_checkpoint(engine, opts)?;
-            interrupted = true;
-            break;
+            break true;
         }
         let mut next = opts.end_step.min(step + 2000);
         if opts.write_saves {
@@ -129,7 +127,7 @@ pub fn run(
             b.set_position(engine.core().step);
             b.set_message(format!("t = {:.3}", engine.core().time));
         }
-    }
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
