@@ -2,7 +2,7 @@
 //! law a `mu = 0` case runs), the pair-list rebuild, one full time step of
 //! MercuryDPM's developed shear state (1 and 2 threads), the team's barrier (the fixed cost of
 //! synchronising two threads, paid twice a step), and the coarse-graining of one save.
-//! Needs `../shared/data` beside the repository. Run: `cargo bench`.
+//! Reads `data/states/mercury_t143.85.data`. Run: `cargo bench`.
 
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -25,7 +25,7 @@ fn root() -> PathBuf {
 
 fn developed(threads: usize) -> (Case, Box<dyn Engine>) {
     let case = Case::load(&root().join("cases/shear_flow_quick.toml")).unwrap();
-    let init = root().join("../shared/data/states/mercury_t143.85.data");
+    let init = root().join("data/states/mercury_t143.85.data");
     let scene = verdem::scene::build(&case, Some(&init)).unwrap();
     let mut e = engine::build(
         &case,

@@ -102,7 +102,7 @@ enum Command {
         /// Case file (default: cases/shear_flow_quick.toml).
         case: Option<PathBuf>,
         /// State to start from (default: MercuryDPM's developed state).
-        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        #[arg(long, default_value = "data/states/mercury_t143.85.data")]
         from: PathBuf,
         #[arg(long, default_value_t = 20_000, value_parser = count::<u64>)]
         steps: u64,
@@ -172,7 +172,7 @@ enum Command {
         #[arg(default_value = "cases/shear_flow_quick.toml")]
         case: PathBuf,
         /// State to start from.
-        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        #[arg(long, default_value = "data/states/mercury_t143.85.data")]
         from: PathBuf,
         #[arg(long, default_value_t = 20000, value_parser = count::<u64>)]
         steps: u64,
@@ -197,7 +197,7 @@ enum Command {
         #[arg(default_value = "cases/shear_flow_quick.toml")]
         case: PathBuf,
         /// State to start from.
-        #[arg(long, default_value = "../shared/data/states/mercury_t143.85.data")]
+        #[arg(long, default_value = "data/states/mercury_t143.85.data")]
         from: PathBuf,
         /// Simulated time of every variant (time units).
         #[arg(long, default_value_t = 20.0, allow_negative_numbers = true, value_parser = positive)]

@@ -1276,7 +1276,7 @@ mod tests {
     #[test]
     fn after_a_rebuild_the_pair_pass_visits_only_pairs_within_reach() {
         let case = Case::load(Path::new("cases/shear_flow_quick.toml")).unwrap();
-        let state = Path::new("../shared/data/states/mercury_t143.85.data");
+        let state = Path::new("data/states/mercury_t143.85.data");
         for steps in [800, 1000, 1200, 1400] {
             let scene = crate::scene::build(&case, Some(state)).unwrap();
             let o = Overrides {

@@ -32,7 +32,7 @@ fn steady_state_steps_allocate_nothing() {
     let case = common::quick_case();
     let mut e = common::engine(
         &case,
-        Some(&common::shared("states/mercury_t143.85.data")),
+        Some(&common::data("states/mercury_t143.85.data")),
         Default::default(),
     );
     // warm up: several pair-list rebuilds size every buffer

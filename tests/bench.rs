@@ -7,7 +7,7 @@ mod common;
 #[test]
 fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
     let dir = tempfile::tempdir().unwrap();
-    let state = common::shared("states/mercury_t143.85.data");
+    let state = common::data("states/mercury_t143.85.data");
     let args = [
         "bench", "--steps", "300", "--rounds", "1", "--np", "1,2", "--out",
     ];

@@ -215,7 +215,7 @@ fn coarse_grains_a_series_verdem_wrote() {
     let dir = tempfile::tempdir().unwrap();
     let mut e = common::engine(
         &case,
-        Some(&common::shared("states/mercury_t143.85.data")),
+        Some(&common::data("states/mercury_t143.85.data")),
         Default::default(),
     );
     common::run_with_saves(e.as_mut(), dir.path(), "s", 2000, 500);

@@ -205,7 +205,7 @@ fn a_run_of_another_scene_writes_no_shear_profiles() {
 #[test]
 fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     let case = "cases/shear_flow_quick.toml";
-    let state = "../shared/data/states/mercury_t143.85.data";
+    let state = "data/states/mercury_t143.85.data";
     let run_args = |out: &str| {
         [
             "run",

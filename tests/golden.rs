@@ -123,7 +123,7 @@ fn quick_shear_from_generated_scene() {
 fn quick_shear_from_official_file() {
     check(
         "official",
-        Some(&shared("GranularShearFlow.data")),
+        Some(&data("GranularShearFlow.data")),
         "--init GranularShearFlow.data",
     );
 }
@@ -132,7 +132,7 @@ fn quick_shear_from_official_file() {
 fn quick_shear_from_developed_state() {
     check(
         "developed",
-        Some(&shared("states/mercury_t143.85.data")),
+        Some(&data("states/mercury_t143.85.data")),
         "--init states/mercury_t143.85.data",
     );
 }

@@ -11,7 +11,7 @@ fn lammps_and_liggghts_run_the_generated_inputs() {
     let case = common::quick_case();
     let e = common::engine(
         &case,
-        Some(&common::shared("states/mercury_t143.85.data")),
+        Some(&common::data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     let dir = tempfile::tempdir().unwrap();
@@ -36,7 +36,7 @@ fn data_file_carries_every_particle_with_its_type_and_velocity() {
     let case = common::quick_case();
     let e = common::engine(
         &case,
-        Some(&common::shared("states/mercury_t143.85.data")),
+        Some(&common::data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     let snap = e.core().snapshot();
@@ -73,7 +73,7 @@ fn data_file_carries_every_particle_with_its_type_and_velocity() {
 fn cross_runs_agree_to_round_off_with_the_peers_convention_and_not_without() {
     use verdem::peers::cross::{convention_of, cross};
     let case = common::quick_case();
-    let state = common::shared("states/mercury_t143.85.data");
+    let state = common::data("states/mercury_t143.85.data");
     let dir = tempfile::tempdir().unwrap();
     for peer in [Peer::Lammps, Peer::Liggghts] {
         let out = dir.path().join(peer.binary());

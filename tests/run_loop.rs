@@ -26,7 +26,7 @@ fn options(dir: &std::path::Path, end: u64, checkpoint_every: u64) -> RunOptions
 #[test]
 fn resumed_run_matches_uninterrupted_run_bit_for_bit() {
     let case = quick_case();
-    let state = shared("states/mercury_t143.85.data");
+    let state = data("states/mercury_t143.85.data");
     let full_dir = tempfile::tempdir().unwrap();
     let mut full = engine(&case, Some(&state), Overrides::default());
     let reference = run::run(full.as_mut(), &options(full_dir.path(), 3000, 0), false).unwrap();
@@ -68,7 +68,7 @@ fn checkpoint_of_another_case_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let e = engine(
         &case,
-        Some(&shared("states/mercury_t143.85.data")),
+        Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     let p = dir.path().join("x.checkpoint");
@@ -103,7 +103,7 @@ fn saves_round_trip_and_follow_mercurydpm_conventions() {
     let dir = tempfile::tempdir().unwrap();
     let mut e = engine(
         &case,
-        Some(&shared("states/mercury_t143.85.data")),
+        Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     run::run(e.as_mut(), &options(dir.path(), 1000, 0), false).unwrap();

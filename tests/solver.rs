@@ -16,7 +16,7 @@ fn reproduces_mercurydpm_contact_at_save_1() {
     let case = quick_case();
     let mut e = engine(
         &case,
-        Some(&shared("outputs_example/Mercury_out.data.0000")),
+        Some(&data("outputs_example/Mercury_out.data.0000")),
         Overrides::default(),
     );
     e.advance(50_000);
@@ -26,7 +26,7 @@ fn reproduces_mercurydpm_contact_at_save_1() {
     let ours = dir.path().join("ours.fstat");
     std::fs::write(&ours, mercury::fstat_text(&snap)).unwrap();
     let ours = mercury::read_fstat(&ours).unwrap();
-    let theirs = mercury::read_fstat(&shared("outputs_example/Mercury_out.fstat.0001")).unwrap();
+    let theirs = mercury::read_fstat(&data("outputs_example/Mercury_out.fstat.0001")).unwrap();
     assert_eq!(ours.rows.len(), theirs.rows.len(), "contact count");
     for (a, b) in ours.rows.iter().zip(&theirs.rows) {
         assert_eq!((a.i, a.j), (b.i, b.j));
@@ -52,7 +52,7 @@ fn reproduces_mercurydpm_contact_at_save_1() {
 #[test]
 fn cell_list_gives_the_same_trajectory_as_all_pairs() {
     let case = quick_case();
-    let state = shared("states/mercury_t143.85.data");
+    let state = data("states/mercury_t143.85.data");
     let mut cells = engine(&case, Some(&state), Overrides::default());
     let mut all = {
         let mut c = case.clone();
@@ -70,7 +70,7 @@ fn cell_list_gives_the_same_trajectory_as_all_pairs() {
 #[test]
 fn threads_skin_and_cell_size_do_not_change_a_bit() {
     let case = quick_case();
-    let state = shared("states/mercury_t143.85.data");
+    let state = data("states/mercury_t143.85.data");
     let run = |threads, bind, skin, cell| {
         let mut e = engine(
             &case,
@@ -98,7 +98,7 @@ fn threads_skin_and_cell_size_do_not_change_a_bit() {
 #[test]
 fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
     let case = quick_case();
-    let state = shared("states/mercury_t143.85.data");
+    let state = data("states/mercury_t143.85.data");
     let reference = hash_after(
         engine(&case, Some(&state), Overrides::default()).as_mut(),
         700,
@@ -130,7 +130,7 @@ fn one_ulp_in_one_velocity_changes_the_hash() {
     let case = quick_case();
     let e = engine(
         &case,
-        Some(&shared("states/mercury_t143.85.data")),
+        Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     let mut snap = e.core().snapshot();
@@ -147,7 +147,7 @@ fn reordered_force_summation_changes_the_hash() {
     let case = quick_case();
     let mut e = engine(
         &case,
-        Some(&shared("states/mercury_t143.85.data")),
+        Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
     e.advance(100);
@@ -171,7 +171,7 @@ fn reordered_force_summation_changes_the_hash() {
 /// for threads that are not running) and still gives the bits of one thread.
 #[test]
 fn a_team_larger_than_its_cpus_is_warned_about_and_keeps_the_bits() {
-    let state = shared("states/mercury_t143.85.data");
+    let state = data("states/mercury_t143.85.data");
     let case = root().join("cases/shear_flow_quick.toml");
     let cpu = verdem::team::allowed_cpus()
         .first()

@@ -11,7 +11,7 @@ fn variants_change_what_they_should_and_nothing_else() {
     let out = verdem::tradeoff::run(
         &case,
         &pair,
-        &common::shared("states/mercury_t143.85.data"),
+        &common::data("states/mercury_t143.85.data"),
         0.2,
         4,
         dir.path(),

@@ -7,7 +7,7 @@
 //! `gran/hooke/history` scales damping by the effective mass and gives a frozen partner its own
 //! mass) and `absolute_damping on` in LIGGGHTS; wall spheres are moved by `fix move linear` and so
 //! act as infinite mass; LIGGGHTS needs `neigh_modify contact_distance_factor 1.01` so that a
-//! tangential spring is reset when its contact ends (`../shared/benchmark.md`, known pitfalls).
+//! tangential spring is reset when its contact ends (`docs/benchmark.md`, known pitfalls).
 
 use std::fmt::Write;
 use std::path::Path;

@@ -14,14 +14,10 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// A file of the benchmark's shared data (`../shared/data/...`); the tests need it and say so.
-pub fn shared(rel: &str) -> PathBuf {
-    let p = root().join("../shared/data").join(rel);
-    assert!(
-        p.exists(),
-        "{} is missing: the tests need the benchmark's shared data beside the repository",
-        p.display()
-    );
+/// A file of the repository's reference data (`data/...`, see `data/README.md`).
+pub fn data(rel: &str) -> PathBuf {
+    let p = root().join("data").join(rel);
+    assert!(p.exists(), "{} is missing from the repository", p.display());
     p
 }
 
