@@ -16,7 +16,7 @@ use verdem::contact::{
     MercurySlidingFriction, PairInput,
 };
 use verdem::engine::{self, Overrides};
-use verdem::sim::Engine;
+use verdem::step::Engine;
 use verdem::Vec3;
 
 fn root() -> PathBuf {

@@ -12,7 +12,7 @@ use anyhow::Context;
 use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::peers::{self, Peer};
-use crate::sim::StageTimes;
+use crate::step::StageTimes;
 use crate::team::{Bound, SpinBarrier};
 
 /// One configuration: a code and its number of threads or MPI ranks.
@@ -153,7 +153,7 @@ pub fn run(
                         .collect::<anyhow::Result<Vec<_>>>()?;
                     let copies = *copies;
                     let start = std::sync::Barrier::new(copies);
-                    let time_copy = |k: usize, e: &mut dyn crate::sim::Engine| {
+                    let time_copy = |k: usize, e: &mut dyn crate::step::Engine| {
                         let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
                         start.wait();
                         let t0 = Instant::now();
@@ -200,7 +200,7 @@ pub fn run(
 }
 
 /// Advances `steps` steps in chunks as a run does (progress and saves happen between them).
-fn advance_in_chunks(e: &mut dyn crate::sim::Engine, steps: u64) {
+fn advance_in_chunks(e: &mut dyn crate::step::Engine, steps: u64) {
     let mut left = steps;
     while left > 0 {
         let k = left.min(2000);

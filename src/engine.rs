@@ -10,7 +10,7 @@ use crate::contact::{
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
-use crate::sim::{Core, Engine, Simulation};
+use crate::step::{Core, Engine, Simulation};
 use crate::Vec3;
 
 /// Overrides of the case's numerical settings (command line).

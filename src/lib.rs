@@ -2,26 +2,22 @@
 //! and a reproducible benchmark suite for the ON-DEM "granular shear flow between bumpy walls" case.
 //!
 //! Data flow of a run: [`case`] (TOML, validated) → [`scene`] (walls and free spheres, generated or
-//! read) → [`sim`] (the time step, top to bottom) → [`io`] (MercuryCG `.data`/`.fstat` saves,
-//! checkpoints) and [`diagnostics`].
+//! read) into a [`state`] → [`step`] (the time step, top to bottom, under a [`contact`] law) →
+//! [`io`] (MercuryCG `.data`/`.fstat` saves, checkpoints, hash, diagnostics).
 
 pub mod bench;
 pub mod case;
 pub mod cg;
-pub mod checkpoint;
 pub mod contact;
-pub mod diagnostics;
-pub mod domain;
 pub mod engine;
-pub mod hash;
 pub mod io;
 pub mod kinematics;
 pub mod neighbor;
 pub mod peers;
 pub mod run;
 pub mod scene;
-pub mod sim;
 pub mod state;
+pub mod step;
 pub mod team;
 pub mod tradeoff;
 pub mod verify;

@@ -10,8 +10,9 @@ use clap::{Parser, Subcommand};
 use verdem::case::Case;
 use verdem::cg::{self, table::Table, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
+use verdem::io::{checkpoint, hash};
 use verdem::run::{self, RunOptions};
-use verdem::{bench, checkpoint, hash, scene};
+use verdem::{bench, scene};
 
 #[derive(Parser)]
 #[command(
@@ -339,7 +340,7 @@ fn non_negative(s: &str) -> Result<f64, String> {
     }
 }
 
-fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::sim::Engine>)> {
+fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::step::Engine>)> {
     let case = Case::load(&common.case)?;
     let scene = scene::build(&case, common.init.as_deref())?;
     let o = Overrides {

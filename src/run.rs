@@ -8,9 +8,9 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 
-use crate::diagnostics::{Diagnostics, CSV_HEADER};
+use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
 use crate::io::{atomic, mercury};
-use crate::sim::{Engine, StageTimes};
+use crate::step::{Engine, StageTimes};
 
 /// Options of one run.
 #[derive(Clone, Debug)]
@@ -135,7 +135,7 @@ pub fn run(
     Ok(RunSummary {
         step: core.step,
         time: core.time,
-        hash: crate::hash::state_hash(&core.snapshot()),
+        hash: crate::io::hash::state_hash(&core.snapshot()),
         steps_run: core.step - start_step,
         seconds: t0.elapsed().as_secs_f64(),
         stages: core.times,
@@ -145,7 +145,7 @@ pub fn run(
 }
 
 fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()> {
-    crate::checkpoint::write(
+    crate::io::checkpoint::write(
         &checkpoint_path(&opts.out_dir, &opts.name),
         &engine.core().snapshot(),
         engine.core().dt,

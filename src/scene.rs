@@ -8,8 +8,8 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 
 use crate::case::{Case, Scene as SceneSpec};
-use crate::domain::Domain;
 use crate::io::{mercury, official};
+use crate::state::Domain;
 use crate::state::{Motion, Particles};
 use crate::Vec3;
 

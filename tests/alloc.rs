@@ -37,7 +37,7 @@ fn steady_state_steps_allocate_nothing() {
     );
     // warm up: several pair-list rebuilds size every buffer
     e.advance(20_000);
-    let count = |e: &mut Box<dyn verdem::sim::Engine>, steps| {
+    let count = |e: &mut Box<dyn verdem::step::Engine>, steps| {
         let before = ALLOCATIONS.load(Ordering::Relaxed);
         e.advance(steps);
         ALLOCATIONS.load(Ordering::Relaxed) - before

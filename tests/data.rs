@@ -15,7 +15,10 @@ fn every_reference_file_has_the_sha256_its_readme_states() {
         let stated = cells[cells.len() - 2].trim_matches('`');
         let bytes = std::fs::read(common::data(name)).unwrap();
         let actual = format!("{:x}", Sha256::digest(&bytes));
-        assert_eq!(actual, stated, "data/{name}: its SHA-256 differs from data/README.md");
+        assert_eq!(
+            actual, stated,
+            "data/{name}: its SHA-256 differs from data/README.md"
+        );
         checked += 1;
     }
     assert_eq!(checked, 5, "data/README.md lists five files");

@@ -134,9 +134,9 @@ fn one_ulp_in_one_velocity_changes_the_hash() {
         Overrides::default(),
     );
     let mut snap = e.core().snapshot();
-    let before = verdem::hash::state_hash(&snap);
+    let before = verdem::io::hash::state_hash(&snap);
     snap.particles.v[2000].y = f64::from_bits(snap.particles.v[2000].y.to_bits() + 1);
-    assert_ne!(verdem::hash::state_hash(&snap), before);
+    assert_ne!(verdem::io::hash::state_hash(&snap), before);
 }
 
 /// The hash sees a change of summation order: the contact forces of the developed state summed
@@ -162,7 +162,7 @@ fn reordered_force_summation_changes_the_hash() {
         let mut s = snap.clone();
         // a particle starting from rest: its velocity is the kick alone
         s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.core().dt;
-        verdem::hash::state_hash(&s)
+        verdem::io::hash::state_hash(&s)
     };
     assert_ne!(kick(forward), kick(backward));
 }

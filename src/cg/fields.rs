@@ -6,8 +6,8 @@
 use nalgebra::Matrix3;
 
 use super::kernel::Kernel;
-use crate::domain::Domain;
 use crate::io::mercury::{DataFile, FstatFile};
+use crate::state::Domain;
 use crate::Vec3;
 
 /// A 3×3 tensor.

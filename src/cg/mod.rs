@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 
-use crate::domain::Domain;
 use crate::io::mercury;
+use crate::state::Domain;
 use fields::{derive, raw_fields, Derived, Grid, Raw};
 use kernel::Kernel;
 use table::Table;

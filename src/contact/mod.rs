@@ -12,6 +12,7 @@ pub mod conventions;
 pub mod normal;
 pub mod tangential;
 
+pub use crate::state::PairForce;
 use crate::Vec3;
 pub use conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, Objective, YadeApprox,
@@ -48,19 +49,6 @@ pub struct PairKinematics {
     /// Angular velocities of P and I (1/time).
     pub w_p: Vec3,
     pub w_i: Vec3,
-}
-
-/// Force and torques produced by one contact.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PairForce {
-    /// Total force on P (I receives −f).
-    pub f: Vec3,
-    /// Signed normal force f·n (negative in the attractive tail when not clipped).
-    pub fn_signed: f64,
-    /// Torque on P about its centre.
-    pub torque_p: Vec3,
-    /// Torque on I about its centre.
-    pub torque_i: Vec3,
 }
 
 /// Everything known about the two spheres of a candidate pair.

@@ -16,9 +16,9 @@ use std::path::Path;
 
 use super::{fmt_f64, parse_numbers, FormatError};
 use crate::contact::PairInput;
-use crate::domain::Domain;
-use crate::sim::Snapshot;
+use crate::state::Domain;
 use crate::state::Motion;
+use crate::state::Snapshot;
 use crate::Vec3;
 
 fn push_vec(s: &mut String, v: &Vec3) {

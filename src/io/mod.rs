@@ -1,7 +1,10 @@
-//! Files: MercuryCG `.data`/`.fstat` saves, the official initial-configuration format, atomic
-//! writes.
+//! Files: MercuryCG `.data`/`.fstat` saves, the official initial-configuration format,
+//! checkpoints, the state hash, the diagnostics table, atomic writes.
 
 pub mod atomic;
+pub mod checkpoint;
+pub mod diagnostics;
+pub mod hash;
 pub mod mercury;
 pub mod official;
 

@@ -22,7 +22,7 @@ use crate::contact::PairForce;
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
-use crate::sim::{Contact, Snapshot};
+use crate::state::{Contact, Snapshot};
 use crate::Vec3;
 
 /// The verdem convention that matches `peer`'s contact law.

@@ -20,8 +20,8 @@ pub mod cross;
 pub mod dump;
 
 use crate::case::{Case, Scene};
-use crate::sim::Snapshot;
 use crate::state::Motion;
+use crate::state::Snapshot;
 
 /// A peer code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

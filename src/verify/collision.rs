@@ -99,7 +99,7 @@ pub fn impact_setup(
     base: &Case,
     bodies: [Body; 2],
     per_tc: f64,
-) -> anyhow::Result<(Case, Box<dyn crate::sim::Engine>)> {
+) -> anyhow::Result<(Case, Box<dyn crate::step::Engine>)> {
     let mut case = base.clone();
     case.run.dt = None;
     case.run.steps_per_collision = Some(per_tc);

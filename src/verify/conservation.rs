@@ -19,10 +19,10 @@
 
 use super::{row_abs, Row};
 use crate::case::{Case, Tangential};
-use crate::domain::Domain;
 use crate::engine::{self, Overrides};
 use crate::scene::{self, random_velocities, Scene};
-use crate::sim::Snapshot;
+use crate::state::Domain;
+use crate::state::Snapshot;
 use crate::state::{Motion, Particles};
 use crate::Vec3;
 

@@ -1,8 +1,8 @@
 //! Per-save diagnostics: kinetic energy of the free particles, contact count, and the total
 //! force the free particles exert on each wall group.
 
-use crate::sim::Snapshot;
 use crate::state::Motion;
+use crate::state::Snapshot;
 use crate::Vec3;
 
 /// One row of the diagnostics table.

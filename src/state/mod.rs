@@ -1,5 +1,11 @@
 //! Particle arrays (structure of arrays) for free and wall spheres.
 
+pub mod domain;
+pub mod snapshot;
+
+pub use domain::Domain;
+pub use snapshot::{Contact, PairForce, Snapshot};
+
 use crate::Vec3;
 
 /// How a particle moves.

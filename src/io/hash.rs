@@ -4,7 +4,7 @@
 
 use sha2::{Digest, Sha256};
 
-use crate::sim::Snapshot;
+use crate::state::Snapshot;
 
 /// Hex SHA-256 of the state.
 pub fn state_hash(core: &Snapshot) -> String {

@@ -29,9 +29,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::contact::{ContactLaw, PairForce, PairInput};
-use crate::domain::Domain;
 use crate::neighbor::{NeighborBuilder, PairList};
-use crate::state::{Motion, Particles};
+use crate::state::Domain;
+use crate::state::{Contact, Motion, Particles, Snapshot};
 use crate::team::{balanced_ranges, Bound, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 
@@ -58,27 +58,6 @@ impl StageTimes {
         self.integrate -= waited;
         self.wait += waited;
     }
-}
-
-/// One contact of a [`Snapshot`], by original particle indices `p < i`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Contact {
-    pub p: u32,
-    pub i: u32,
-    /// Elastic tangential displacement (length).
-    pub xi: Vec3,
-    /// Force and torques of the last evaluation (force on P).
-    pub force: PairForce,
-}
-
-/// The state in canonical order: particles by id, contacts sorted by `(p, i)`.
-#[derive(Clone, Debug)]
-pub struct Snapshot {
-    pub step: u64,
-    pub time: f64,
-    pub domain: Domain,
-    pub particles: Particles,
-    pub contacts: Vec<Contact>,
 }
 
 /// Everything a step advances, independent of the contact law. Particle arrays are in memory

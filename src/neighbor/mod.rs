@@ -7,7 +7,7 @@
 //! oriented by original ids (P = lower id), and each particle's list of pairs is sorted by its
 //! partners' original ids.
 
-use crate::domain::Domain;
+use crate::state::Domain;
 use crate::Vec3;
 
 /// How candidate pairs are found.

@@ -7,7 +7,8 @@ use std::path::Path;
 use anyhow::{bail, Context};
 
 use crate::contact::PairForce;
-use crate::sim::{Contact, Core, Snapshot};
+use crate::state::{Contact, Snapshot};
+use crate::step::Core;
 use crate::Vec3;
 
 const MAGIC: &[u8; 8] = b"VERDEMC1";

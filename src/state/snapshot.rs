@@ -1,0 +1,38 @@
+//! The state in canonical order: what saves, hashes and checkpoints are made of.
+
+use super::{Domain, Particles};
+use crate::Vec3;
+
+/// Force and torques produced by one contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairForce {
+    /// Total force on P (I receives −f).
+    pub f: Vec3,
+    /// Signed normal force f·n (negative in the attractive tail when not clipped).
+    pub fn_signed: f64,
+    /// Torque on P about its centre.
+    pub torque_p: Vec3,
+    /// Torque on I about its centre.
+    pub torque_i: Vec3,
+}
+
+/// One contact of a [`Snapshot`], by original particle indices `p < i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    pub p: u32,
+    pub i: u32,
+    /// Elastic tangential displacement (length).
+    pub xi: Vec3,
+    /// Force and torques of the last evaluation (force on P).
+    pub force: PairForce,
+}
+
+/// The state in canonical order: particles by id, contacts sorted by `(p, i)`.
+#[derive(Clone, Debug)]
+pub struct Snapshot {
+    pub step: u64,
+    pub time: f64,
+    pub domain: Domain,
+    pub particles: Particles,
+    pub contacts: Vec<Contact>,
+}
