@@ -146,8 +146,10 @@ pub fn run(
                                 },
                             );
                             e.advance(0);
-                            e.core_mut().times = StageTimes::default();
-                            e.core_mut().lockstep = barrier.clone();
+                            e.core_mut().counters = StageTimes::default();
+                            e.core_mut().params.meet = barrier
+                                .clone()
+                                .map(|b| Arc::new(move || b.wait()) as crate::step::MeetHook);
                             Ok(e)
                         })
                         .collect::<anyhow::Result<Vec<_>>>()?;
@@ -178,7 +180,7 @@ pub fn run(
                     if copies > 1 {
                         m.copy_rates.push(own);
                     }
-                    m.stages = Some(engines[0].core().times);
+                    m.stages = Some(engines[0].core().counters);
                 }
                 Config::Peer { peer, np } => {
                     let dir = work.join(format!("{}-{np}", peer.binary()));

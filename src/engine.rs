@@ -100,7 +100,7 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         builder,
         o.threads.unwrap_or(case.run.threads),
     );
-    core.time = scene.time;
-    core.bind = o.bind.unwrap_or(true);
+    core.state.time = scene.time;
+    core.params.bind = o.bind.unwrap_or(true);
     with_law(&case.contact, BuildSimulation(core))
 }

@@ -350,7 +350,7 @@ fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::step::Engine>)
         cell: common.cell,
     };
     let engine = engine::build(&case, scene, &o);
-    if let Some(warning) = verdem::team::oversubscribed(engine.core().threads) {
+    if let Some(warning) = verdem::team::oversubscribed(engine.core().params.threads) {
         eprintln!("warning: {warning}");
     }
     Ok((case, engine))
@@ -381,17 +381,17 @@ fn real_main() -> anyhow::Result<Finished> {
         } => {
             let (case, mut engine) = load(&common)?;
             print_contact_summary(&case);
-            let tag = format!("{}:{}", case.name, engine.core().particles.len());
+            let tag = format!("{}:{}", case.name, engine.core().state.particles.len());
             if let Some(ck) = &resume {
                 checkpoint::read(ck, engine.core_mut(), &tag)?;
                 println!(
                     "resumed at step {} (t = {})",
-                    engine.core().step,
-                    engine.core().time
+                    engine.core().state.step,
+                    engine.core().state.time
                 );
             }
             let end_step = steps.unwrap_or(case.run.steps);
-            if end_step < engine.core().step {
+            if end_step < engine.core().state.step {
                 anyhow::bail!(
                     "the run would end at step {end_step} ({}), before the checkpoint's step {}",
                     if steps.is_some() {
@@ -399,7 +399,7 @@ fn real_main() -> anyhow::Result<Finished> {
                     } else {
                         "the case's run.steps"
                     },
-                    engine.core().step
+                    engine.core().state.step
                 );
             }
             let opts = RunOptions {
@@ -446,7 +446,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 println!(
                     "rate: {:.0} steps/s on {} thread(s) ({:.1} s){projection}",
                     s.rate(),
-                    engine.core().threads,
+                    engine.core().params.threads,
                     s.seconds,
                 );
             } else {
@@ -461,7 +461,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 ms(st.forces),
                 ms(st.integrate),
                 ms(st.wait),
-                engine.core().pairs.p.len()
+                engine.core().pair_count()
             );
             println!("state hash: {}", s.hash);
             let summary = format!(
@@ -470,7 +470,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 s.step,
                 s.time,
                 s.hash,
-                engine.core().threads,
+                engine.core().params.threads,
                 s.rate()
             );
             let p = opts.out_dir.join(format!("{}.summary.toml", case.name));

@@ -80,18 +80,18 @@ pub fn run(
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
     if opts.write_saves {
-        prepare_diagnostics(&diag, engine.core().step, opts.save_every, resumed)?;
+        prepare_diagnostics(&diag, engine.core().state.step, opts.save_every, resumed)?;
     }
-    let start_step = engine.core().step;
+    let start_step = engine.core().state.step;
     let bar = progress_bar(opts, start_step);
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
     let interrupted = loop {
         let core = engine.core();
-        let step = core.step;
+        let step = core.state.step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
-            if !core.forces_ready {
+            if !core.state.forces_ready {
                 engine.advance(0);
             }
             write_save(engine, opts, &diag)?;
@@ -124,8 +124,8 @@ pub fn run(
         }
         engine.advance(next - step);
         if let Some(b) = &bar {
-            b.set_position(engine.core().step);
-            b.set_message(format!("t = {:.3}", engine.core().time));
+            b.set_position(engine.core().state.step);
+            b.set_message(format!("t = {:.3}", engine.core().state.time));
         }
     };
     if let Some(b) = bar {
@@ -133,12 +133,12 @@ pub fn run(
     }
     let core = engine.core();
     Ok(RunSummary {
-        step: core.step,
-        time: core.time,
+        step: core.state.step,
+        time: core.state.time,
         hash: crate::io::hash::state_hash(&core.snapshot()),
-        steps_run: core.step - start_step,
+        steps_run: core.state.step - start_step,
         seconds: t0.elapsed().as_secs_f64(),
-        stages: core.times,
+        stages: core.counters,
         saves,
         interrupted,
     })
@@ -148,7 +148,7 @@ fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()
     crate::io::checkpoint::write(
         &checkpoint_path(&opts.out_dir, &opts.name),
         &engine.core().snapshot(),
-        engine.core().dt,
+        engine.core().params.dt,
         &opts.tag,
     )
 }

@@ -17,9 +17,7 @@ const SPIN: Duration = Duration::from_micros(50);
 /// after which the partner that woke it often waits past its own spin: one late arrival
 /// cascades. Yielding keeps the CPU awake through the waits a step has (the longest is a
 /// pair-list rebuild's serial phase, well under a millisecond) while still giving the core to
-/// any other runnable thread. Measured on the 2-vCPU CI machine (Firecracker, halt-polling off):
-/// 2 threads ran 16 % faster than with sleeping straight after the spin (median of 80 paired
-/// rounds of 5000 steps, faster in 58).
+/// any other runnable thread (measured: `docs/performance.md`).
 const YIELD: Duration = Duration::from_millis(2);
 
 /// A reusable barrier for a fixed number of threads. Threads spin for up to [`SPIN`], then
@@ -251,11 +249,9 @@ pub fn allowed_cpus() -> Vec<usize> {
 
 /// Binds the calling thread to one CPU while it lives, then gives it back the CPUs it had. A
 /// team left to the scheduler loses time when a thread is moved, or starts on its partner's
-/// CPU (each run spawns its threads anew): on the 2-vCPU CI machine, binding thread t to the
-/// t-th allowed CPU made 2 threads 15 % and, in a second reading, 7 % faster (medians of 60
-/// paired rounds of 5000 steps, faster in 45 and 38), and cut their barrier waits from 3.4 to
-/// 1.4 µs a step. Open MPI's `mpirun` binds ranks to cores the same way when it starts two or
-/// fewer.
+/// CPU (each run spawns its threads anew); binding saves both (measured:
+/// `docs/performance.md`). Open MPI's `mpirun` binds ranks to cores the same way when it starts
+/// two or fewer.
 pub struct Bound {
     previous: libc::cpu_set_t,
 }
@@ -306,9 +302,8 @@ impl Drop for Bound {
 
 /// The warning for a team of `threads` threads when the process may run on fewer CPUs
 /// (affinity mask or CPU quota, as `std::thread::available_parallelism` reads them), else
-/// `None`. Such a team waits at every barrier for threads that are not running: on the 2-vCPU
-/// CI machine, 2 threads under `taskset -c 0` took 3.1–3.3 s for 20000 developed steps
-/// against 0.7–0.9 s for 1 thread (`verdem hash`, 2026-11-23).
+/// `None`. Such a team waits at every barrier for threads that are not running (measured:
+/// `docs/performance.md`).
 pub fn oversubscribed(threads: usize) -> Option<String> {
     let cpus = std::thread::available_parallelism().ok()?.get();
     (threads > cpus).then(|| {
@@ -320,14 +315,61 @@ pub fn oversubscribed(threads: usize) -> Option<String> {
     })
 }
 
-/// A value shared by the team whose parts are written by one thread at a time, as arranged by
-/// the step's phases, barriers and marks (each thread writes only its own index range between
-/// two barriers; reads of data written by others happen only after a barrier, or after the
-/// [`Marks`] of the chunks that wrote them).
+/// Who runs a phased job such as a pair-list rebuild: the team, each thread between the same
+/// barriers, or one thread alone (outside a run), which then does every chunk of each parallel
+/// phase itself.
+#[derive(Clone, Copy)]
+pub enum Crew<'b> {
+    Solo,
+    Member {
+        tid: usize,
+        barrier: &'b SpinBarrier,
+        /// The chunks of the parallel phases.
+        queue: &'b WorkQueue,
+    },
+}
+
+impl Crew<'_> {
+    /// Whether this thread does the serial phases.
+    pub fn leads(self) -> bool {
+        matches!(self, Crew::Solo | Crew::Member { tid: 0, .. })
+    }
+
+    /// Waits for the whole crew.
+    pub fn sync(self) {
+        if let Crew::Member { barrier, .. } = self {
+            barrier.wait();
+        }
+    }
+
+    /// A parallel phase: runs `job` on each of the `chunks` chunks this thread takes (all of
+    /// them, alone), then waits for the whole crew.
+    pub fn share(self, chunks: usize, mut job: impl FnMut(usize)) {
+        match self {
+            Crew::Solo => (0..chunks).for_each(job),
+            Crew::Member {
+                tid,
+                barrier,
+                queue,
+            } => {
+                while let Some(c) = queue.next(tid) {
+                    job(c);
+                }
+                barrier.wait();
+                // The next parallel phase starts after a serial one and its barrier.
+                queue.refill(tid);
+            }
+        }
+    }
+}
+
+/// A value the team's threads take turns on: in a serial phase one thread has it exclusively
+/// while the others wait at a barrier; in a parallel phase every thread may read it (and writes
+/// only through [`SharedSlice`]s to its own chunks' elements).
 pub struct Shared<T>(UnsafeCell<T>);
 
-// SAFETY: access is coordinated by the phase structure described above; the acquire/release
-// orderings of the barrier and of the marks publish each phase's writes to the next phase.
+// SAFETY: access follows the phase rules of `read` and `exclusive`; the acquire/release orderings
+// of the barrier and of the marks publish each phase's writes to the next phase.
 unsafe impl<T: Send> Sync for Shared<T> {}
 
 impl<T> Shared<T> {
@@ -336,14 +378,122 @@ impl<T> Shared<T> {
         Shared(UnsafeCell::new(value))
     }
 
-    /// Shared access.
+    /// Read access during a parallel phase.
     ///
     /// # Safety
-    /// No thread may be writing the parts read, in the same phase.
+    /// No thread holds the value from [`Shared::exclusive`] while the reference lives.
+    #[inline(always)]
+    pub unsafe fn read(&self) -> &T {
+        &*self.0.get()
+    }
+
+    /// Exclusive access during a serial phase.
+    ///
+    /// # Safety
+    /// No other reference to the value, from `read` or `exclusive`, lives while this one does:
+    /// the other threads wait at a barrier and take fresh references after it.
     #[inline(always)]
     #[allow(clippy::mut_from_ref)]
-    pub unsafe fn get(&self) -> &mut T {
+    pub unsafe fn exclusive(&self) -> &mut T {
         &mut *self.0.get()
+    }
+}
+
+/// A raw view of an array that the team's threads read and write element-wise during a phase,
+/// each writing only the elements of the chunks it takes. Taken from the array by the thread that
+/// owns it exclusively, between barriers; valid until the array is next resized, re-allocated or
+/// swapped (the next pair-list rebuild), after which a fresh view must be taken.
+pub struct SharedSlice<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+impl<T> Clone for SharedSlice<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for SharedSlice<T> {}
+
+impl<T> Default for SharedSlice<T> {
+    fn default() -> Self {
+        SharedSlice {
+            ptr: std::ptr::NonNull::dangling().as_ptr(),
+            len: 0,
+        }
+    }
+}
+
+// SAFETY: a view is only a pointer and a length; every access through it is an `unsafe` call
+// whose caller states which thread owns the elements it touches in that phase.
+unsafe impl<T: Send> Send for SharedSlice<T> {}
+unsafe impl<T: Send> Sync for SharedSlice<T> {}
+
+impl<T> SharedSlice<T> {
+    /// A view of `v`'s elements (no reference to them is kept).
+    pub fn of(v: &mut [T]) -> Self {
+        SharedSlice {
+            ptr: v.as_mut_ptr(),
+            len: v.len(),
+        }
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when the view has no elements.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Element `k`, copied out.
+    ///
+    /// # Safety
+    /// `k < len`; the view is valid; no thread writes element `k` during the read.
+    #[inline(always)]
+    pub unsafe fn get(&self, k: usize) -> T
+    where
+        T: Copy,
+    {
+        debug_assert!(k < self.len);
+        self.ptr.add(k).read()
+    }
+
+    /// The elements `range`, read-only.
+    ///
+    /// # Safety
+    /// `range` lies within the view; the view is valid; no thread writes these elements while
+    /// the slice lives.
+    #[inline(always)]
+    pub unsafe fn slice(&self, range: std::ops::Range<usize>) -> &[T] {
+        debug_assert!(range.start <= range.end && range.end <= self.len);
+        std::slice::from_raw_parts(self.ptr.add(range.start), range.end - range.start)
+    }
+
+    /// The elements `range`, writable.
+    ///
+    /// # Safety
+    /// `range` lies within the view; the view is valid; no other thread reads or writes these
+    /// elements, and no other reference to them lives, while the slice lives.
+    #[inline(always)]
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn slice_mut(&self, range: std::ops::Range<usize>) -> &mut [T] {
+        debug_assert!(range.start <= range.end && range.end <= self.len);
+        std::slice::from_raw_parts_mut(self.ptr.add(range.start), range.end - range.start)
+    }
+
+    /// Element `k`, writable.
+    ///
+    /// # Safety
+    /// As [`SharedSlice::slice_mut`] for the one element `k`.
+    #[inline(always)]
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn at_mut(&self, k: usize) -> &mut T {
+        debug_assert!(k < self.len);
+        &mut *self.ptr.add(k)
     }
 }
 

@@ -72,7 +72,7 @@ fn checkpoint_of_another_case_is_refused() {
         Overrides::default(),
     );
     let p = dir.path().join("x.checkpoint");
-    verdem::io::checkpoint::write(&p, &e.core().snapshot(), e.core().dt, "q:3480").unwrap();
+    verdem::io::checkpoint::write(&p, &e.core().snapshot(), e.core().params.dt, "q:3480").unwrap();
     let mut other = engine(&case, None, Overrides::default());
     let err = verdem::io::checkpoint::read(&p, other.core_mut(), "other:3480").unwrap_err();
     assert!(err.to_string().contains("checkpoint of case"), "{err}");

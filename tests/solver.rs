@@ -111,7 +111,7 @@ fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
                 let (case, state) = (&case, &state);
                 s.spawn(move || {
                     let mut e = engine(case, Some(state), Overrides::default());
-                    e.core_mut().lockstep = Some(barrier);
+                    e.core_mut().params.meet = Some(std::sync::Arc::new(move || barrier.wait()));
                     // several calls, each a run of its own (the first with a rebuild)
                     e.advance(300);
                     hash_after(e.as_mut(), 400)
@@ -161,7 +161,7 @@ fn reordered_force_summation_changes_the_hash() {
     let kick = |f: verdem::Vec3| {
         let mut s = snap.clone();
         // a particle starting from rest: its velocity is the kick alone
-        s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.core().dt;
+        s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.core().params.dt;
         verdem::io::hash::state_hash(&s)
     };
     assert_ne!(kick(forward), kick(backward));

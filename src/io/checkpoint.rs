@@ -106,19 +106,19 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
     snap.step = r.u64()?;
     snap.time = r.f64()?;
     let dt = r.f64()?;
-    if dt.to_bits() != core.dt.to_bits() {
+    if dt.to_bits() != core.params.dt.to_bits() {
         bail!(
             "{}: checkpoint dt {dt} differs from the case's {}",
             path.display(),
-            core.dt
+            core.params.dt
         );
     }
     let n = r.u64()? as usize;
-    if n != core.particles.len() {
+    if n != core.state.particles.len() {
         bail!(
             "{}: checkpoint has {n} particles, the case {}",
             path.display(),
-            core.particles.len()
+            core.state.particles.len()
         );
     }
     let p = &mut snap.particles;
@@ -158,5 +158,5 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
         );
     }
     core.restore(&snap);
-    Ok(core.step)
+    Ok(core.state.step)
 }

@@ -7,6 +7,8 @@
 //! oriented by original ids (P = lower id), and each particle's list of pairs is sorted by its
 //! partners' original ids.
 
+pub mod rebuild;
+
 use crate::state::Domain;
 use crate::Vec3;
 

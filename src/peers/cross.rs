@@ -197,7 +197,7 @@ pub fn cross(
     let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
     // both peers compute their setup forces without advancing the tangential history
     // (`update->setupflag`)
-    e.core_mut().setup_advances_history = false;
+    e.core_mut().params.setup_advances_history = false;
     e.advance(0);
     let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
     for d in [&peer_dir, &own_dir] {

@@ -1,0 +1,229 @@
+//! What a time step advances and the settings it runs with, split by who owns them: the state
+//! (saved, hashed, checkpointed), the parameters (set once per run), the counters, and the
+//! workspace the step keeps between steps.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use super::counters::StageTimes;
+use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
+use crate::neighbor::NeighborBuilder;
+use crate::state::{Contact, Domain, Particles, Snapshot};
+use crate::team::{Crew, Shared};
+use crate::Vec3;
+
+/// The dynamic state. Particle arrays are in memory order (re-ordered by cell at every pair-list
+/// build); [`Core::snapshot`] gives the canonical (id) order.
+pub struct State {
+    pub domain: Domain,
+    pub particles: Particles,
+    /// Original index (0-based id) of each particle in memory order.
+    pub id: Vec<u32>,
+    /// Candidate pairs with their contact history and last forces.
+    pub pairs: Pairs,
+    /// Index of the current step: the state is x_n, v_n, ω_n with the forces of step n.
+    pub step: u64,
+    /// Simulated time, accumulated as a running sum of dt (as MercuryDPM does).
+    pub time: f64,
+    /// Whether `particles.f`/`t` hold the forces of the current state.
+    pub forces_ready: bool,
+}
+
+/// Called by thread 0 once a step, right after the team's threads meet; `verdem bench` uses it
+/// to couple independent runs.
+pub type MeetHook = Arc<dyn Fn() + Send + Sync>;
+
+/// Settings of the step.
+pub struct Params {
+    /// Time step (time units).
+    pub dt: f64,
+    /// Gravity (acceleration), `None` when the case has none: no gravity pass at all.
+    pub gravity: Option<Vec3>,
+    /// Worker threads of the step.
+    pub threads: usize,
+    /// Whether a team of more than one thread binds thread t to the t-th CPU the process may
+    /// run on, while it runs (when the team fits on distinct CPUs); the default.
+    pub bind: bool,
+    /// Whether the force evaluation before the first step advances the tangential springs by
+    /// one step, as MercuryDPM's does (true, the default); LAMMPS and LIGGGHTS skip the
+    /// history update during their setup (`update->setupflag`), which cross-runs mirror.
+    pub setup_advances_history: bool,
+    /// Called once a step after the meeting, on thread 0; `None` for a normal run.
+    pub meet: Option<MeetHook>,
+}
+
+/// What the step keeps between steps besides the state: the pair list's builder and plan, the
+/// particles' flags, and how far particles may have moved since the last build.
+pub(super) struct Workspace {
+    /// Upper bounds of the displacement since the last pair-list build of any slow [0] and of
+    /// any fast [1] particle, by their speed class at that build (length).
+    pub moved_bound: [f64; 2],
+    pub builder: NeighborBuilder,
+    pub plan: Plan,
+    pub flags: Flags,
+}
+
+/// Everything a step advances and runs with, independent of the contact law.
+pub struct Core {
+    pub state: State,
+    pub params: Params,
+    pub counters: StageTimes,
+    pub(super) work: Workspace,
+}
+
+/// The pair list and everything that moves with it, borrowed from the state and the workspace.
+pub(super) fn list_state<'a>(state: &'a mut State, work: &'a mut Workspace) -> ListState<'a> {
+    ListState {
+        particles: &mut state.particles,
+        id: &mut state.id,
+        pairs: &mut state.pairs,
+        builder: &mut work.builder,
+        plan: &mut work.plan,
+        flags: &mut work.flags,
+    }
+}
+
+impl Core {
+    /// A state at step 0, time 0 (time units), with no forces evaluated yet; particles in id
+    /// order; `dt` in time units, `gravity` an acceleration.
+    pub fn new(
+        domain: Domain,
+        particles: Particles,
+        dt: f64,
+        gravity: Option<Vec3>,
+        builder: NeighborBuilder,
+        threads: usize,
+    ) -> Self {
+        let threads = threads.max(1);
+        Core {
+            state: State {
+                id: (0..particles.len() as u32).collect(),
+                domain,
+                particles,
+                pairs: Pairs::default(),
+                step: 0,
+                time: 0.0,
+                forces_ready: false,
+            },
+            params: Params {
+                dt,
+                gravity,
+                threads,
+                bind: true,
+                setup_advances_history: true,
+                meet: None,
+            },
+            counters: StageTimes::default(),
+            work: Workspace {
+                moved_bound: [0.0; 2],
+                builder,
+                plan: Plan::new(threads),
+                flags: Flags::default(),
+            },
+        }
+    }
+
+    /// Skin of the pair list (length).
+    pub fn skin(&self) -> f64 {
+        self.work.builder.skin
+    }
+
+    /// Number of candidate pairs at the last build.
+    pub fn pair_count(&self) -> usize {
+        self.state.pairs.list.p.len()
+    }
+
+    /// Re-orders the particles and rebuilds the pair list on this thread, keeping every
+    /// contact's history.
+    pub fn rebuild(&mut self) {
+        let domain = self.state.domain.clone();
+        let start = std::time::Instant::now();
+        let list = Shared::new(list_state(&mut self.state, &mut self.work));
+        // SAFETY: a crew of one: every phase runs on this thread.
+        unsafe { rebuild::rebuild(Crew::Solo, &list, &domain) };
+        self.counters.neighbor += start.elapsed().as_nanos() as u64;
+        self.counters.rebuilds += 1;
+        self.work.moved_bound = [0.0; 2];
+    }
+
+    /// Rebuilds the pair list and sets the given contacts (by original ids) as active with
+    /// their history and force; used when resuming from a checkpoint.
+    pub fn restore_contacts(&mut self, contacts: &[Contact]) {
+        let pairs = &mut self.state.pairs;
+        pairs.active.fill(false);
+        pairs.xi.fill(Vec3::zeros());
+        self.rebuild();
+        let (pairs, id) = (&mut self.state.pairs, &self.state.id);
+        let slot: HashMap<u64, usize> = (0..pairs.list.p.len())
+            .map(|k| {
+                let (p, i) = (pairs.list.p[k] as usize, pairs.list.i[k] as usize);
+                (key(id[p], id[i]), k)
+            })
+            .collect();
+        for c in contacts {
+            if let Some(&k) = slot.get(&key(c.p, c.i)) {
+                pairs.xi[k] = c.xi;
+                pairs.out[k] = c.force;
+                pairs.active[k] = true;
+            }
+        }
+        self.state.forces_ready = true;
+    }
+
+    /// Number of pairs in contact at the last force evaluation.
+    pub fn contact_count(&self) -> usize {
+        self.state.pairs.active.iter().filter(|a| **a).count()
+    }
+
+    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
+    pub fn snapshot(&self) -> Snapshot {
+        let s = &self.state;
+        let n = s.particles.len();
+        let mut pos = vec![0usize; n];
+        for (a, &id) in s.id.iter().enumerate() {
+            pos[id as usize] = a;
+        }
+        let src = &s.particles;
+        let mut particles = Particles::default();
+        for &a in &pos {
+            particles.x.push(src.x[a]);
+            particles.v.push(src.v[a]);
+            particles.w.push(src.w[a]);
+            particles.radius.push(src.radius[a]);
+            particles.inv_mass.push(src.inv_mass[a]);
+            particles.inv_inertia.push(src.inv_inertia[a]);
+            particles.motion.push(src.motion[a]);
+            particles.f.push(src.f[a]);
+            particles.t.push(src.t[a]);
+        }
+        let pairs = &s.pairs;
+        let mut contacts: Vec<Contact> = (0..pairs.list.p.len())
+            .filter(|&k| pairs.active[k])
+            .map(|k| Contact {
+                p: s.id[pairs.list.p[k] as usize],
+                i: s.id[pairs.list.i[k] as usize],
+                xi: pairs.xi[k],
+                force: pairs.out[k],
+            })
+            .collect();
+        contacts.sort_unstable_by_key(|c| key(c.p, c.i));
+        Snapshot {
+            step: s.step,
+            time: s.time,
+            domain: s.domain.clone(),
+            particles,
+            contacts,
+        }
+    }
+
+    /// Overwrites the dynamic state from a canonical snapshot of the same scene.
+    pub fn restore(&mut self, snap: &Snapshot) {
+        let n = self.state.particles.len();
+        assert_eq!(n, snap.particles.len(), "snapshot of another scene");
+        self.state.id = (0..n as u32).collect();
+        self.state.particles = snap.particles.clone();
+        self.state.step = snap.step;
+        self.state.time = snap.time;
+        self.restore_contacts(&snap.contacts);
+    }
+}
