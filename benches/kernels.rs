@@ -83,7 +83,7 @@ fn pair_kernel(c: &mut Criterion) {
 fn rebuild(c: &mut Criterion) {
     let (_, mut e) = developed(1);
     c.bench_function("pair-list rebuild, developed state", |b| {
-        b.iter(|| e.core_mut().rebuild())
+        b.iter(|| e.rebuild())
     });
 }
 
@@ -115,7 +115,7 @@ fn barrier(c: &mut Criterion) {
 
 fn coarse_grain(c: &mut Criterion) {
     let (_, e) = developed(1);
-    let snap = e.core().snapshot();
+    let snap = e.snapshot();
     let dir = tempfile::tempdir().unwrap();
     let (dp, fp) = (dir.path().join("b.data"), dir.path().join("b.fstat"));
     std::fs::write(&dp, verdem::io::mercury::data_text(&snap)).unwrap();

@@ -114,7 +114,7 @@ pub fn run(
         );
         crate::io::atomic::write(
             &data_path,
-            peers::data_file(&e.core().snapshot(), case.material.density).as_bytes(),
+            peers::data_file(&e.snapshot(), case.material.density).as_bytes(),
         )?;
     }
     let mut out: Vec<Measured> = configs
@@ -146,8 +146,8 @@ pub fn run(
                                 },
                             );
                             e.advance(0);
-                            e.core_mut().counters = StageTimes::default();
-                            e.core_mut().params.meet = barrier
+                            *e.counters_mut() = StageTimes::default();
+                            e.params_mut().meet = barrier
                                 .clone()
                                 .map(|b| Arc::new(move || b.wait()) as crate::step::MeetHook);
                             Ok(e)
@@ -180,7 +180,7 @@ pub fn run(
                     if copies > 1 {
                         m.copy_rates.push(own);
                     }
-                    m.stages = Some(engines[0].core().counters);
+                    m.stages = Some(*engines[0].counters());
                 }
                 Config::Peer { peer, np } => {
                     let dir = work.join(format!("{}-{np}", peer.binary()));

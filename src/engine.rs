@@ -74,12 +74,31 @@ where
     }
 }
 
-struct BuildSimulation(Core);
+/// The parts of a simulation besides its law; the law decides the type of its contacts'
+/// history, so the core is made once the law is known.
+struct BuildSimulation {
+    scene: Scene,
+    dt: f64,
+    gravity: Option<Vec3>,
+    builder: NeighborBuilder,
+    threads: usize,
+    bind: bool,
+}
 
 impl LawVisitor for BuildSimulation {
     type Output = Box<dyn Engine>;
     fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Box<dyn Engine> {
-        Box::new(Simulation::new(law, self.0))
+        let mut core = Core::new(
+            self.scene.domain,
+            self.scene.particles,
+            self.dt,
+            self.gravity,
+            self.builder,
+            self.threads,
+        );
+        core.state.time = self.scene.time;
+        core.params.bind = self.bind;
+        Box::new(Simulation::new(law, core))
     }
 }
 
@@ -92,15 +111,13 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         r_max,
         case.neighbor.search,
     );
-    let mut core = Core::new(
-        scene.domain,
-        scene.particles,
-        case.dt(),
-        case.gravity().map(Vec3::from),
+    let parts = BuildSimulation {
+        scene,
+        dt: case.dt(),
+        gravity: case.gravity().map(Vec3::from),
         builder,
-        o.threads.unwrap_or(case.run.threads),
-    );
-    core.state.time = scene.time;
-    core.params.bind = o.bind.unwrap_or(true);
-    with_law(&case.contact, BuildSimulation(core))
+        threads: o.threads.unwrap_or(case.run.threads),
+        bind: o.bind.unwrap_or(true),
+    };
+    with_law(&case.contact, parts)
 }

@@ -63,13 +63,39 @@ pub enum Increment {
 
 /// A contact law behind a pointer (the driver needs no static dispatch).
 pub trait DynLaw {
-    /// As [`ContactLaw::evaluate`].
-    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce;
+    /// A new contact of this law, with no history yet.
+    fn new_contact(&self) -> Box<dyn DynContact + '_>;
+}
+
+/// One contact of a law, carrying the law's history from one evaluation to the next.
+pub trait DynContact {
+    /// As [`ContactLaw::evaluate`], over the step `dt` (time), advancing the contact's history.
+    fn evaluate(&mut self, k: &PairKinematics, dt: f64) -> PairForce;
+    /// Forgets the history (the spheres are apart).
+    fn forget(&mut self);
+}
+
+/// A law and the history of one of its contacts.
+struct LawContact<'a, L: ContactLaw> {
+    law: &'a L,
+    history: L::History,
+}
+
+impl<L: ContactLaw> DynContact for LawContact<'_, L> {
+    fn evaluate(&mut self, k: &PairKinematics, dt: f64) -> PairForce {
+        self.law.evaluate(k, &mut self.history, dt)
+    }
+    fn forget(&mut self) {
+        self.history = L::History::default();
+    }
 }
 
 impl<L: ContactLaw> DynLaw for L {
-    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce {
-        ContactLaw::evaluate(self, k, xi, dt)
+    fn new_contact(&self) -> Box<dyn DynContact + '_> {
+        Box::new(LawContact {
+            law: self,
+            history: L::History::default(),
+        })
     }
 }
 
@@ -112,7 +138,7 @@ pub fn drive(
     rows: &[MotionRow],
     increment: Increment,
 ) -> Vec<ForceRow> {
-    let mut xi = Vec3::zeros();
+    let mut contact = law.new_contact();
     let mut out = Vec::with_capacity(rows.len());
     for (k, row) in rows.iter().enumerate() {
         let (v, w, dt) = match (k, increment) {
@@ -145,7 +171,7 @@ pub fn drive(
         };
         out.push(match input.kinematics() {
             Some(kin) => {
-                let p = law.evaluate(&kin, &mut xi, dt);
+                let p = contact.evaluate(&kin, dt);
                 ForceRow {
                     t: row.t,
                     f: [-p.f, p.f],
@@ -157,7 +183,7 @@ pub fn drive(
             }
             None => {
                 // apart: the history is forgotten, as in the solver
-                xi = Vec3::zeros();
+                contact.forget();
                 ForceRow {
                     t: row.t,
                     f: [Vec3::zeros(); 2],

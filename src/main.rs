@@ -350,7 +350,7 @@ fn load(common: &Common) -> anyhow::Result<(Case, Box<dyn verdem::step::Engine>)
         cell: common.cell,
     };
     let engine = engine::build(&case, scene, &o);
-    if let Some(warning) = verdem::team::oversubscribed(engine.core().params.threads) {
+    if let Some(warning) = verdem::team::oversubscribed(engine.params().threads) {
         eprintln!("warning: {warning}");
     }
     Ok((case, engine))
@@ -381,17 +381,17 @@ fn real_main() -> anyhow::Result<Finished> {
         } => {
             let (case, mut engine) = load(&common)?;
             print_contact_summary(&case);
-            let tag = format!("{}:{}", case.name, engine.core().state.particles.len());
+            let tag = format!("{}:{}", case.name, engine.state().particles.len());
             if let Some(ck) = &resume {
-                checkpoint::read(ck, engine.core_mut(), &tag)?;
+                checkpoint::read(ck, engine.as_mut(), &tag)?;
                 println!(
                     "resumed at step {} (t = {})",
-                    engine.core().state.step,
-                    engine.core().state.time
+                    engine.state().step,
+                    engine.state().time
                 );
             }
             let end_step = steps.unwrap_or(case.run.steps);
-            if end_step < engine.core().state.step {
+            if end_step < engine.state().step {
                 anyhow::bail!(
                     "the run would end at step {end_step} ({}), before the checkpoint's step {}",
                     if steps.is_some() {
@@ -399,7 +399,7 @@ fn real_main() -> anyhow::Result<Finished> {
                     } else {
                         "the case's run.steps"
                     },
-                    engine.core().state.step
+                    engine.state().step
                 );
             }
             let opts = RunOptions {
@@ -446,7 +446,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 println!(
                     "rate: {:.0} steps/s on {} thread(s) ({:.1} s){projection}",
                     s.rate(),
-                    engine.core().params.threads,
+                    engine.params().threads,
                     s.seconds,
                 );
             } else {
@@ -461,7 +461,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 ms(st.forces),
                 ms(st.integrate),
                 ms(st.wait),
-                engine.core().pair_count()
+                engine.pair_count()
             );
             println!("state hash: {}", s.hash);
             let summary = format!(
@@ -470,7 +470,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 s.step,
                 s.time,
                 s.hash,
-                engine.core().params.threads,
+                engine.params().threads,
                 s.rate()
             );
             let p = opts.out_dir.join(format!("{}.summary.toml", case.name));
@@ -716,7 +716,7 @@ fn real_main() -> anyhow::Result<Finished> {
         Command::Hash { common, steps } => {
             let (_, mut engine) = load(&common)?;
             engine.advance(steps);
-            println!("{}", hash::state_hash(&engine.core().snapshot()));
+            println!("{}", hash::state_hash(&engine.snapshot()));
         }
     }
     Ok(Finished::Done)

@@ -80,18 +80,17 @@ pub fn run(
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
     if opts.write_saves {
-        prepare_diagnostics(&diag, engine.core().state.step, opts.save_every, resumed)?;
+        prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)?;
     }
-    let start_step = engine.core().state.step;
+    let start_step = engine.state().step;
     let bar = progress_bar(opts, start_step);
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
     let interrupted = loop {
-        let core = engine.core();
-        let step = core.state.step;
+        let step = engine.state().step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
-            if !core.state.forces_ready {
+            if !engine.state().forces_ready {
                 engine.advance(0);
             }
             write_save(engine, opts, &diag)?;
@@ -124,21 +123,21 @@ pub fn run(
         }
         engine.advance(next - step);
         if let Some(b) = &bar {
-            b.set_position(engine.core().state.step);
-            b.set_message(format!("t = {:.3}", engine.core().state.time));
+            b.set_position(engine.state().step);
+            b.set_message(format!("t = {:.3}", engine.state().time));
         }
     };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let core = engine.core();
+    let state = engine.state();
     Ok(RunSummary {
-        step: core.state.step,
-        time: core.state.time,
-        hash: crate::io::hash::state_hash(&core.snapshot()),
-        steps_run: core.state.step - start_step,
+        step: state.step,
+        time: state.time,
+        hash: crate::io::hash::state_hash(&engine.snapshot()),
+        steps_run: state.step - start_step,
         seconds: t0.elapsed().as_secs_f64(),
-        stages: core.counters,
+        stages: *engine.counters(),
         saves,
         interrupted,
     })
@@ -147,14 +146,14 @@ pub fn run(
 fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()> {
     crate::io::checkpoint::write(
         &checkpoint_path(&opts.out_dir, &opts.name),
-        &engine.core().snapshot(),
-        engine.core().params.dt,
+        &engine.snapshot(),
+        engine.params().dt,
         &opts.tag,
     )
 }
 
 fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
-    let core = &engine.core().snapshot();
+    let core = &engine.snapshot();
     let k = core.step / opts.save_every;
     let data = save_path(&opts.out_dir, &opts.name, "data", k);
     atomic::write(&data, mercury::data_text(core).as_bytes())

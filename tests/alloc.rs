@@ -44,7 +44,7 @@ fn steady_state_steps_allocate_nothing() {
     };
     let one = count(&mut e, 1);
     let many = count(&mut e, 10_000);
-    let rebuilds = e.core().counters.rebuilds;
+    let rebuilds = e.counters().rebuilds;
     assert!(
         rebuilds > 20,
         "the measured steps include pair-list rebuilds ({rebuilds})"

@@ -16,7 +16,7 @@ fn lammps_and_liggghts_run_the_generated_inputs() {
     );
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("state.lmp");
-    std::fs::write(&data, peers::data_file(&e.core().snapshot(), 1.0)).unwrap();
+    std::fs::write(&data, peers::data_file(&e.snapshot(), 1.0)).unwrap();
     for peer in [Peer::Lammps, Peer::Liggghts] {
         let script =
             peers::input_script(peer, &case, &data.display().to_string(), 200, None).unwrap();
@@ -39,7 +39,7 @@ fn data_file_carries_every_particle_with_its_type_and_velocity() {
         Some(&common::data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
-    let snap = e.core().snapshot();
+    let snap = e.snapshot();
     let text = peers::data_file(&snap, 1.0);
     let atoms: Vec<&str> = text
         .split("Atoms # sphere\n\n")

@@ -44,7 +44,7 @@ fn resumed_run_matches_uninterrupted_run_bit_for_bit() {
             ..Overrides::default()
         },
     );
-    let step = verdem::io::checkpoint::read(&ck, second.core_mut(), "q:3480").unwrap();
+    let step = verdem::io::checkpoint::read(&ck, second.as_mut(), "q:3480").unwrap();
     assert_eq!(step, 1500);
     let resumed = run::run(second.as_mut(), &options(dir.path(), 3000, 1500), true).unwrap();
     assert_eq!(resumed.step, 3000);
@@ -72,22 +72,22 @@ fn checkpoint_of_another_case_is_refused() {
         Overrides::default(),
     );
     let p = dir.path().join("x.checkpoint");
-    verdem::io::checkpoint::write(&p, &e.core().snapshot(), e.core().params.dt, "q:3480").unwrap();
+    verdem::io::checkpoint::write(&p, &e.snapshot(), e.params().dt, "q:3480").unwrap();
     let mut other = engine(&case, None, Overrides::default());
-    let err = verdem::io::checkpoint::read(&p, other.core_mut(), "other:3480").unwrap_err();
+    let err = verdem::io::checkpoint::read(&p, other.as_mut(), "other:3480").unwrap_err();
     assert!(err.to_string().contains("checkpoint of case"), "{err}");
     // a truncated checkpoint says where it ends; a short foreign file is no checkpoint
     let bytes = std::fs::read(&p).unwrap();
     let cut = dir.path().join("cut.checkpoint");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let err = verdem::io::checkpoint::read(&cut, other.core_mut(), "q:3480").unwrap_err();
+    let err = verdem::io::checkpoint::read(&cut, other.as_mut(), "q:3480").unwrap_err();
     assert!(
         err.to_string().contains("checkpoint truncated at byte"),
         "{err}"
     );
     for junk in [&b"garbage"[..], b"garbage and more"] {
         std::fs::write(&cut, junk).unwrap();
-        let err = verdem::io::checkpoint::read(&cut, other.core_mut(), "q:3480").unwrap_err();
+        let err = verdem::io::checkpoint::read(&cut, other.as_mut(), "q:3480").unwrap_err();
         assert!(
             err.to_string().ends_with("not a verdem checkpoint"),
             "{err}"
@@ -107,7 +107,7 @@ fn saves_round_trip_and_follow_mercurydpm_conventions() {
         Overrides::default(),
     );
     run::run(e.as_mut(), &options(dir.path(), 1000, 0), false).unwrap();
-    let snap = e.core().snapshot();
+    let snap = e.snapshot();
     let data = mercury::read_data(&run::save_path(dir.path(), "q", "data", 1)).unwrap();
     assert_eq!(data.time.to_bits(), snap.time.to_bits());
     assert_eq!(data.rows.len(), 3480);

@@ -20,7 +20,7 @@ fn reproduces_mercurydpm_contact_at_save_1() {
         Overrides::default(),
     );
     e.advance(50_000);
-    let snap = e.core().snapshot();
+    let snap = e.snapshot();
     assert!((snap.time - 3.596272516).abs() < 1e-9, "time {}", snap.time);
     let dir = tempfile::tempdir().unwrap();
     let ours = dir.path().join("ours.fstat");
@@ -61,7 +61,7 @@ fn cell_list_gives_the_same_trajectory_as_all_pairs() {
     };
     let a = hash_after(cells.as_mut(), 3000);
     let b = hash_after(all.as_mut(), 3000);
-    assert!(cells.core().contact_count() > 0, "a contact-rich state");
+    assert!(cells.contact_count() > 0, "a contact-rich state");
     assert_eq!(a, b);
 }
 
@@ -111,7 +111,7 @@ fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
                 let (case, state) = (&case, &state);
                 s.spawn(move || {
                     let mut e = engine(case, Some(state), Overrides::default());
-                    e.core_mut().params.meet = Some(std::sync::Arc::new(move || barrier.wait()));
+                    e.params_mut().meet = Some(std::sync::Arc::new(move || barrier.wait()));
                     // several calls, each a run of its own (the first with a rebuild)
                     e.advance(300);
                     hash_after(e.as_mut(), 400)
@@ -133,7 +133,7 @@ fn one_ulp_in_one_velocity_changes_the_hash() {
         Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
-    let mut snap = e.core().snapshot();
+    let mut snap = e.snapshot();
     let before = verdem::io::hash::state_hash(&snap);
     snap.particles.v[2000].y = f64::from_bits(snap.particles.v[2000].y.to_bits() + 1);
     assert_ne!(verdem::io::hash::state_hash(&snap), before);
@@ -151,7 +151,7 @@ fn reordered_force_summation_changes_the_hash() {
         Overrides::default(),
     );
     e.advance(100);
-    let snap = e.core().snapshot();
+    let snap = e.snapshot();
     let terms: Vec<_> = snap.contacts.iter().map(|c| c.force.f).collect();
     assert!(terms.len() >= 3);
     let forward = terms.iter().fold(verdem::Vec3::zeros(), |s, f| s + f);
@@ -161,7 +161,7 @@ fn reordered_force_summation_changes_the_hash() {
     let kick = |f: verdem::Vec3| {
         let mut s = snap.clone();
         // a particle starting from rest: its velocity is the kick alone
-        s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.core().params.dt;
+        s.particles.v[a] = f * s.particles.inv_mass[a] * 0.5 * e.params().dt;
         verdem::io::hash::state_hash(&s)
     };
     assert_ne!(kick(forward), kick(backward));

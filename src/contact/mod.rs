@@ -12,6 +12,7 @@ pub mod conventions;
 pub mod normal;
 pub mod tangential;
 
+use crate::state::History;
 pub use crate::state::PairForce;
 use crate::Vec3;
 pub use conventions::{
@@ -112,9 +113,12 @@ pub trait ContactLaw: Send + Sync {
     /// and rotation entirely.
     const TANGENTIAL: bool;
 
-    /// Force and torques of a contact, updating the tangential history `xi` (the elastic
-    /// tangential displacement, length units) over one time step `dt`.
-    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce;
+    /// What the law carries per contact from one step to the next; the solver stores, saves,
+    /// hashes and restores it without looking inside.
+    type History: History;
+
+    /// Force and torques of a contact, updating its `history` over one time step `dt` (time).
+    fn evaluate(&self, k: &PairKinematics, history: &mut Self::History, dt: f64) -> PairForce;
 }
 
 /// A normal model and a tangential model composed into a contact law.
@@ -126,6 +130,8 @@ pub struct Composed<N, T> {
 
 impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
     const TANGENTIAL: bool = T::ACTIVE;
+    /// The elastic tangential displacement ξ (length); zero for a frictionless law.
+    type History = Vec3;
 
     #[inline(always)]
     fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce {

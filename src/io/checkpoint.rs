@@ -8,7 +8,7 @@ use anyhow::{bail, Context};
 
 use crate::contact::PairForce;
 use crate::state::{Contact, Snapshot};
-use crate::step::Core;
+use crate::step::Engine;
 use crate::Vec3;
 
 const MAGIC: &[u8; 8] = b"VERDEMC1";
@@ -39,8 +39,11 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result
     for c in &core.contacts {
         b.extend_from_slice(&c.p.to_le_bytes());
         b.extend_from_slice(&c.i.to_le_bytes());
+        for w in &c.history {
+            b.extend_from_slice(&w.to_le_bytes());
+        }
         let o = &c.force;
-        for v in [&c.xi, &o.f, &o.torque_p, &o.torque_i] {
+        for v in [&o.f, &o.torque_p, &o.torque_i] {
             put(&mut b, v);
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
@@ -82,7 +85,8 @@ impl Reader<'_> {
 }
 
 /// Restores a checkpoint into `core` (built from the same case); returns the step it holds.
-pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
+pub fn read(path: &Path, engine: &mut dyn Engine, tag: &str) -> anyhow::Result<u64> {
+    let words = engine.history_words();
     let bytes = std::fs::read(path)
         .with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
     let mut r = Reader {
@@ -102,23 +106,23 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
             path.display()
         );
     }
-    let mut snap = core.snapshot();
+    let mut snap = engine.snapshot();
     snap.step = r.u64()?;
     snap.time = r.f64()?;
     let dt = r.f64()?;
-    if dt.to_bits() != core.params.dt.to_bits() {
+    if dt.to_bits() != engine.params().dt.to_bits() {
         bail!(
             "{}: checkpoint dt {dt} differs from the case's {}",
             path.display(),
-            core.params.dt
+            engine.params().dt
         );
     }
     let n = r.u64()? as usize;
-    if n != core.state.particles.len() {
+    if n != engine.state().particles.len() {
         bail!(
             "{}: checkpoint has {n} particles, the case {}",
             path.display(),
-            core.state.particles.len()
+            engine.state().particles.len()
         );
     }
     let p = &mut snap.particles;
@@ -133,7 +137,9 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
     snap.contacts.clear();
     for _ in 0..contacts {
         let (cp, ci) = (r.u32()?, r.u32()?);
-        let xi = r.vec()?;
+        let history = (0..words)
+            .map(|_| r.f64())
+            .collect::<anyhow::Result<Vec<f64>>>()?;
         let f = r.vec()?;
         let torque_p = r.vec()?;
         let torque_i = r.vec()?;
@@ -141,7 +147,8 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
         snap.contacts.push(Contact {
             p: cp,
             i: ci,
-            xi,
+            history,
+            spring: Vec3::zeros(),
             force: PairForce {
                 f,
                 fn_signed,
@@ -157,6 +164,6 @@ pub fn read(path: &Path, core: &mut Core, tag: &str) -> anyhow::Result<u64> {
             bytes.len() - r.at
         );
     }
-    core.restore(&snap);
-    Ok(core.state.step)
+    engine.restore(&snap);
+    Ok(engine.state().step)
 }

@@ -1,6 +1,7 @@
 //! SHA-256 of the full dynamic state, serialised canonically: little-endian f64 of positions,
 //! velocities and angular velocities of every particle in id order, then for every contact with
-//! a tangential history, sorted by index pair, `P I` as little-endian u32 and ξ as f64.
+//! a tangential history, sorted by index pair, `P I` as little-endian u32 and the words of its
+//! history as f64 (ξ for every law today).
 
 use sha2::{Digest, Sha256};
 
@@ -20,8 +21,8 @@ pub fn state_hash(core: &Snapshot) -> String {
     for c in &core.contacts {
         h.update(c.p.to_le_bytes());
         h.update(c.i.to_le_bytes());
-        for k in 0..3 {
-            h.update(c.xi[k].to_le_bytes());
+        for w in &c.history {
+            h.update(w.to_le_bytes());
         }
     }
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()

@@ -120,7 +120,7 @@ pub fn fstat_text(core: &Snapshot) -> String {
             fmt_f64(&mut s, core.time);
             s.push_str(&format!(" {} {}", side.i, side.j));
             push_vec(&mut s, &c);
-            for v in [g.delta, -contact.xi.norm(), out.fn_signed, ft] {
+            for v in [g.delta, -contact.spring.norm(), out.fn_signed, ft] {
                 s.push(' ');
                 fmt_f64(&mut s, v);
             }

@@ -11,7 +11,7 @@
 use std::sync::atomic::AtomicBool;
 
 use super::{NeighborBuilder, PairList};
-use crate::state::{Domain, Motion, PairForce, Particles};
+use crate::state::{Domain, History, Motion, PairForce, Particles};
 use crate::team::{balanced_ranges, Crew, Shared, SharedSlice};
 use crate::Vec3;
 
@@ -46,18 +46,32 @@ pub fn key(p: u32, i: u32) -> u64 {
     ((p as u64) << 32) | i as u64
 }
 
-/// The candidate pairs in memory indices and each pair's slots: its contact history and the
+/// The candidate pairs in memory indices and each pair's slots: its contact history `H` and the
 /// force of its last evaluation.
-#[derive(Clone, Debug, Default)]
-pub struct Pairs {
+#[derive(Clone, Debug)]
+pub struct Pairs<H> {
     /// Candidate pairs (within r_P + r_I + skin at the last build).
     pub list: PairList,
-    /// Elastic tangential displacement of each pair (length); zero when not in contact.
-    pub xi: Vec<Vec3>,
+    /// The contact law's history of each pair; `H::default()` when not in contact.
+    pub history: Vec<H>,
     /// Whether each pair was in contact at the last force evaluation.
     pub active: Vec<bool>,
     /// Force and torques of each active pair at the last force evaluation.
     pub out: Vec<PairForce>,
+    /// The histories of the last build's slots while a rebuild carries them over.
+    carried: Vec<H>,
+}
+
+impl<H> Default for Pairs<H> {
+    fn default() -> Self {
+        Pairs {
+            list: PairList::default(),
+            history: Vec::new(),
+            active: Vec::new(),
+            out: Vec::new(),
+            carried: Vec::new(),
+        }
+    }
 }
 
 /// Per-particle flags of the passes (memory order), set or cleared at every build.
@@ -115,7 +129,6 @@ struct Scratch {
     next_p: Vec<u32>,
     next_i: Vec<u32>,
     old_keys: Vec<(u64, u32)>,
-    old_xi: Vec<Vec3>,
     fill: Vec<u32>,
     /// Class and gap bin of each pair, `class · GAP_BINS + bin`, in build order.
     bin: Vec<u8>,
@@ -148,7 +161,6 @@ struct Views {
     next_i: SharedSlice<u32>,
     pair_ranges: SharedSlice<[usize; CLASSES + 1]>,
     pair_hull: SharedSlice<(u32, u32)>,
-    xi: SharedSlice<Vec3>,
     active: SharedSlice<bool>,
 }
 
@@ -179,14 +191,38 @@ impl Plan {
 }
 
 /// The pair list, the particles it indexes, and everything that changes with them.
-pub struct ListState<'a> {
+pub struct ListState<'a, H> {
     pub particles: &'a mut Particles,
     /// Original index of each particle in memory order.
     pub id: &'a mut Vec<u32>,
-    pub pairs: &'a mut Pairs,
+    pub pairs: &'a mut Pairs<H>,
     pub builder: &'a mut NeighborBuilder,
     pub plan: &'a mut Plan,
     pub flags: &'a mut Flags,
+    /// The view the crew writes the pairs' histories through while sorting the pair chunks.
+    pub history: SharedSlice<H>,
+}
+
+impl<'a, H> ListState<'a, H> {
+    /// The list state of these parts (no view taken yet).
+    pub fn new(
+        particles: &'a mut Particles,
+        id: &'a mut Vec<u32>,
+        pairs: &'a mut Pairs<H>,
+        builder: &'a mut NeighborBuilder,
+        plan: &'a mut Plan,
+        flags: &'a mut Flags,
+    ) -> Self {
+        ListState {
+            particles,
+            id,
+            pairs,
+            builder,
+            plan,
+            flags,
+            history: SharedSlice::default(),
+        }
+    }
 }
 
 /// Part `part` of `0..n` split into `parts` nearly equal contiguous ranges.
@@ -218,7 +254,11 @@ unsafe fn permute_range<T: Copy>(
 /// while the others wait at the crew's barrier; in a parallel phase every thread reads `list`
 /// and writes only the elements of the chunks it takes, through the views the lead took before
 /// the phase; no vector is resized or swapped outside the lead's phases.
-pub unsafe fn rebuild(crew: Crew<'_>, list: &Shared<ListState<'_>>, domain: &Domain) {
+pub unsafe fn rebuild<H: History>(
+    crew: Crew<'_>,
+    list: &Shared<ListState<'_, H>>,
+    domain: &Domain,
+) {
     if crew.leads() {
         // SAFETY: serial phase: the other threads wait at the sync below.
         let l = list.exclusive();
@@ -283,7 +323,7 @@ pub unsafe fn rebuild(crew: Crew<'_>, list: &Shared<ListState<'_>>, domain: &Dom
     }
 }
 
-impl ListState<'_> {
+impl<H: History> ListState<'_, H> {
     /// Lead phase: the history of the contacts by original ids; the new memory order; room for
     /// the permutation and the search, and the views the crew writes them through.
     fn remember_contacts(&mut self, domain: &Domain) {
@@ -299,7 +339,7 @@ impl ListState<'_> {
             }
         }
         s.old_keys.sort_unstable();
-        std::mem::swap(&mut s.old_xi, &mut self.pairs.xi);
+        std::mem::swap(&mut self.pairs.carried, &mut self.pairs.history);
         // Memory order by cell; the builder is then ready to search the re-ordered particles.
         self.builder
             .order(domain, &self.particles.x, self.id, &mut s.order);
@@ -392,7 +432,7 @@ impl ListState<'_> {
         plan.live.resize(chunks, [0; CLASSES]);
         // Room only: each chunk clears its pairs' history in `sort_chunk`.
         let pairs = &mut *self.pairs;
-        pairs.xi.resize(n_pairs, Vec3::zeros());
+        pairs.history.resize(n_pairs, H::default());
         pairs.active.resize(n_pairs, false);
         pairs.out.resize(n_pairs, PairForce::default());
         s.views = Views {
@@ -403,10 +443,10 @@ impl ListState<'_> {
             next_i: SharedSlice::of(&mut s.next_i),
             pair_ranges: SharedSlice::of(&mut plan.pair_ranges),
             pair_hull: SharedSlice::of(&mut s.pair_hull),
-            xi: SharedSlice::of(&mut pairs.xi),
             active: SharedSlice::of(&mut pairs.active),
             ..Views::default()
         };
+        self.history = SharedSlice::of(&mut pairs.history);
     }
 
     /// Parallel phase of a rebuild: chunk `part` of the pairs in its final order and with its
@@ -486,8 +526,8 @@ impl ListState<'_> {
             hull = (hull.0.min(p).min(i), hull.1.max(p + 1).max(i + 1));
         }
         *v.pair_hull.at_mut(part) = hull;
-        let (xi, active) = (v.xi.slice_mut(pa..pb), v.active.slice_mut(pa..pb));
-        xi.fill(Vec3::zeros());
+        let (history, active) = (self.history.slice_mut(pa..pb), v.active.slice_mut(pa..pb));
+        history.fill(H::default());
         active.fill(false);
         if s.old_keys.is_empty() {
             return;
@@ -503,7 +543,7 @@ impl ListState<'_> {
             }
             let (p, i) = (self.id[pm], self.id[im]);
             if let Ok(o) = s.old_keys.binary_search_by_key(&key(p, i), |e| e.0) {
-                xi[j] = s.old_xi[s.old_keys[o].1 as usize];
+                history[j] = self.pairs.carried[s.old_keys[o].1 as usize];
                 active[j] = true;
             }
         }
@@ -527,6 +567,7 @@ impl ListState<'_> {
         }
         list.index(self.particles.len(), self.id, &mut s.fill);
         s.views = Views::default();
+        self.history = SharedSlice::default();
         plan.reset_live();
     }
 }

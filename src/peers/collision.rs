@@ -27,7 +27,7 @@ pub fn restitution(
     let dt = timed.dt();
     let (timed, e) = impact_setup(&timed, head_on(v0, wall, dt, 0.5), per_tc)?;
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    let data = data_file(&e.core().snapshot(), case.material.density);
+    let data = data_file(&e.snapshot(), case.material.density);
     atomic::write(&dir.join("pair.lmp"), data.as_bytes())?;
     // the contact with a fixed sphere lasts tc_fw = √2·tc_ff at most; then free flight
     let tc_fw = closed_form(&timed, timed.particle_mass()).tc;

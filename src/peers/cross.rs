@@ -156,7 +156,8 @@ fn peer_contacts(peer: Peer, path: &Path, s: &Snapshot) -> anyhow::Result<Vec<Co
         out.push(Contact {
             p: p as u32,
             i: i as u32,
-            xi: Vec3::zeros(),
+            history: Vec::new(),
+            spring: Vec3::zeros(),
             force: PairForce {
                 f,
                 fn_signed: f.dot(&n),
@@ -197,13 +198,13 @@ pub fn cross(
     let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
     // both peers compute their setup forces without advancing the tangential history
     // (`update->setupflag`)
-    e.core_mut().params.setup_advances_history = false;
+    e.params_mut().setup_advances_history = false;
     e.advance(0);
     let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
     for d in [&peer_dir, &own_dir] {
         std::fs::create_dir_all(d).with_context(|| d.display().to_string())?;
     }
-    let data = super::data_file(&e.core().snapshot(), case.material.density);
+    let data = super::data_file(&e.snapshot(), case.material.density);
     atomic::write(&peer_dir.join("state.lmp"), data.as_bytes())?;
     let script = input_script(peer, &case, "state.lmp", steps, Some(every))?;
     run(peer, np, &peer_dir, &script)?;
@@ -212,7 +213,7 @@ pub fn cross(
         if k > 0 {
             e.advance(every);
         }
-        let own = e.core().snapshot();
+        let own = e.snapshot();
         let name = format!("{}.data.{k:04}", case.name);
         atomic::write(&own_dir.join(&name), data_text(&own).as_bytes())?;
         let fstat = format!("{}.fstat.{k:04}", case.name);

@@ -1,9 +1,11 @@
 //! Particle arrays (structure of arrays) for free and wall spheres.
 
 pub mod domain;
+pub mod history;
 pub mod snapshot;
 
 pub use domain::Domain;
+pub use history::History;
 pub use snapshot::{Contact, PairForce, Snapshot};
 
 use crate::Vec3;

@@ -17,12 +17,15 @@ pub struct PairForce {
 }
 
 /// One contact of a [`Snapshot`], by original particle indices `p < i`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Contact {
     pub p: u32,
     pub i: u32,
-    /// Elastic tangential displacement (length).
-    pub xi: Vec3,
+    /// The contact law's history in its canonical words ([`crate::state::History`]); empty when
+    /// unknown (a peer's contact).
+    pub history: Vec<f64>,
+    /// The elastic tangential displacement (length) of that history, for the `.fstat` output.
+    pub spring: Vec3,
     /// Force and torques of the last evaluation (force on P).
     pub force: PairForce,
 }

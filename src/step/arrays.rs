@@ -6,7 +6,7 @@
 //! - the particle pass writes the particle arrays (`x`, `v`, `w`, `f`, `t`, `quiet`) of the
 //!   chunks it takes only; it reads the slots (`active`, `out`) of its particles' pairs once the
 //!   pair chunks that hold them are marked done;
-//! - the pair pass writes the slots (`xi`, `active`, `out`) of its chunk's pairs and its chunk's
+//! - the pair pass writes the slots (`history`, `active`, `out`) of its chunk's pairs and its chunk's
 //!   `live` ends only, and reads the positions and velocities of its pairs' particles, whose
 //!   particle chunk cannot start until this pair chunk is marked done;
 //! - `touched` flags are atomics, set by the pair pass, cleared by the particle pass;
@@ -21,8 +21,8 @@ use crate::team::SharedSlice;
 use crate::Vec3;
 
 /// Views of every array a step's threads share.
-#[derive(Clone, Copy, Default)]
-pub(super) struct Arrays {
+#[derive(Default)]
+pub(super) struct Arrays<H> {
     pub x: SharedSlice<Vec3>,
     pub v: SharedSlice<Vec3>,
     pub w: SharedSlice<Vec3>,
@@ -39,7 +39,7 @@ pub(super) struct Arrays {
     pub i: SharedSlice<u32>,
     pub adj_start: SharedSlice<u32>,
     pub adj: SharedSlice<u32>,
-    pub xi: SharedSlice<Vec3>,
+    pub history: SharedSlice<H>,
     pub active: SharedSlice<bool>,
     pub out: SharedSlice<PairForce>,
     pub particle_chunks: SharedSlice<(usize, usize)>,
@@ -49,9 +49,17 @@ pub(super) struct Arrays {
     pub needs: SharedSlice<(u32, u32)>,
 }
 
-impl Arrays {
+impl<H> Clone for Arrays<H> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<H> Copy for Arrays<H> {}
+
+impl<H> Arrays<H> {
     /// Views of the arrays of `l`, valid until its next rebuild.
-    pub fn of(l: &mut ListState<'_>) -> Self {
+    pub fn of(l: &mut ListState<'_, H>) -> Self {
         let (pt, pairs, plan, flags) = (
             &mut *l.particles,
             &mut *l.pairs,
@@ -75,7 +83,7 @@ impl Arrays {
             i: SharedSlice::of(&mut pairs.list.i),
             adj_start: SharedSlice::of(&mut pairs.list.adj_start),
             adj: SharedSlice::of(&mut pairs.list.adj),
-            xi: SharedSlice::of(&mut pairs.xi),
+            history: SharedSlice::of(&mut pairs.history),
             active: SharedSlice::of(&mut pairs.active),
             out: SharedSlice::of(&mut pairs.out),
             particle_chunks: SharedSlice::of(&mut plan.particle_chunks),

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use super::counters::StageTimes;
 use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
 use crate::neighbor::NeighborBuilder;
-use crate::state::{Contact, Domain, Particles, Snapshot};
+use crate::state::{Contact, Domain, History, Particles, Snapshot};
 use crate::team::{Crew, Shared};
 use crate::Vec3;
 
@@ -19,8 +19,6 @@ pub struct State {
     pub particles: Particles,
     /// Original index (0-based id) of each particle in memory order.
     pub id: Vec<u32>,
-    /// Candidate pairs with their contact history and last forces.
-    pub pairs: Pairs,
     /// Index of the current step: the state is x_n, v_n, ω_n with the forces of step n.
     pub step: u64,
     /// Simulated time, accumulated as a running sum of dt (as MercuryDPM does).
@@ -63,27 +61,30 @@ pub(super) struct Workspace {
     pub flags: Flags,
 }
 
-/// Everything a step advances and runs with, independent of the contact law.
-pub struct Core {
+/// Everything a step advances and runs with, for a contact law of history `H`.
+pub struct Core<H> {
     pub state: State,
+    /// Candidate pairs with their contact history and last forces.
+    pub pairs: Pairs<H>,
     pub params: Params,
     pub counters: StageTimes,
     pub(super) work: Workspace,
 }
 
-/// The pair list and everything that moves with it, borrowed from the state and the workspace.
-pub(super) fn list_state<'a>(state: &'a mut State, work: &'a mut Workspace) -> ListState<'a> {
-    ListState {
-        particles: &mut state.particles,
-        id: &mut state.id,
-        pairs: &mut state.pairs,
-        builder: &mut work.builder,
-        plan: &mut work.plan,
-        flags: &mut work.flags,
+impl<H: History> Core<H> {
+    /// The pair list and everything that moves with it.
+    pub(super) fn list_state(&mut self) -> ListState<'_, H> {
+        let (state, work) = (&mut self.state, &mut self.work);
+        ListState::new(
+            &mut state.particles,
+            &mut state.id,
+            &mut self.pairs,
+            &mut work.builder,
+            &mut work.plan,
+            &mut work.flags,
+        )
     }
-}
 
-impl Core {
     /// A state at step 0, time 0 (time units), with no forces evaluated yet; particles in id
     /// order; `dt` in time units, `gravity` an acceleration.
     pub fn new(
@@ -100,11 +101,11 @@ impl Core {
                 id: (0..particles.len() as u32).collect(),
                 domain,
                 particles,
-                pairs: Pairs::default(),
                 step: 0,
                 time: 0.0,
                 forces_ready: false,
             },
+            pairs: Pairs::default(),
             params: Params {
                 dt,
                 gravity,
@@ -130,7 +131,7 @@ impl Core {
 
     /// Number of candidate pairs at the last build.
     pub fn pair_count(&self) -> usize {
-        self.state.pairs.list.p.len()
+        self.pairs.list.p.len()
     }
 
     /// Re-orders the particles and rebuilds the pair list on this thread, keeping every
@@ -138,7 +139,7 @@ impl Core {
     pub fn rebuild(&mut self) {
         let domain = self.state.domain.clone();
         let start = std::time::Instant::now();
-        let list = Shared::new(list_state(&mut self.state, &mut self.work));
+        let list = Shared::new(self.list_state());
         // SAFETY: a crew of one: every phase runs on this thread.
         unsafe { rebuild::rebuild(Crew::Solo, &list, &domain) };
         self.counters.neighbor += start.elapsed().as_nanos() as u64;
@@ -149,11 +150,11 @@ impl Core {
     /// Rebuilds the pair list and sets the given contacts (by original ids) as active with
     /// their history and force; used when resuming from a checkpoint.
     pub fn restore_contacts(&mut self, contacts: &[Contact]) {
-        let pairs = &mut self.state.pairs;
+        let pairs = &mut self.pairs;
         pairs.active.fill(false);
-        pairs.xi.fill(Vec3::zeros());
+        pairs.history.fill(H::default());
         self.rebuild();
-        let (pairs, id) = (&mut self.state.pairs, &self.state.id);
+        let (pairs, id) = (&mut self.pairs, &self.state.id);
         let slot: HashMap<u64, usize> = (0..pairs.list.p.len())
             .map(|k| {
                 let (p, i) = (pairs.list.p[k] as usize, pairs.list.i[k] as usize);
@@ -162,7 +163,7 @@ impl Core {
             .collect();
         for c in contacts {
             if let Some(&k) = slot.get(&key(c.p, c.i)) {
-                pairs.xi[k] = c.xi;
+                pairs.history[k] = H::from_words(&c.history);
                 pairs.out[k] = c.force;
                 pairs.active[k] = true;
             }
@@ -172,7 +173,7 @@ impl Core {
 
     /// Number of pairs in contact at the last force evaluation.
     pub fn contact_count(&self) -> usize {
-        self.state.pairs.active.iter().filter(|a| **a).count()
+        self.pairs.active.iter().filter(|a| **a).count()
     }
 
     /// The state in canonical order (allocates; for saves, hashes and checkpoints).
@@ -196,14 +197,20 @@ impl Core {
             particles.f.push(src.f[a]);
             particles.t.push(src.t[a]);
         }
-        let pairs = &s.pairs;
+        let pairs = &self.pairs;
         let mut contacts: Vec<Contact> = (0..pairs.list.p.len())
             .filter(|&k| pairs.active[k])
-            .map(|k| Contact {
-                p: s.id[pairs.list.p[k] as usize],
-                i: s.id[pairs.list.i[k] as usize],
-                xi: pairs.xi[k],
-                force: pairs.out[k],
+            .map(|k| {
+                let h = &pairs.history[k];
+                let mut history = Vec::with_capacity(H::WORDS);
+                h.put_words(&mut history);
+                Contact {
+                    p: s.id[pairs.list.p[k] as usize],
+                    i: s.id[pairs.list.i[k] as usize],
+                    history,
+                    spring: h.spring(),
+                    force: pairs.out[k],
+                }
             })
             .collect();
         contacts.sort_unstable_by_key(|c| key(c.p, c.i));

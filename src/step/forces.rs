@@ -24,10 +24,10 @@ pub(super) struct PairView<'a, L> {
 }
 
 /// A range of pairs and their slots.
-pub(super) struct PairSlots<'a> {
+pub(super) struct PairSlots<'a, H> {
     pub p: &'a [u32],
     pub i: &'a [u32],
-    pub xi: &'a mut [Vec3],
+    pub history: &'a mut [H],
     pub active: &'a mut [bool],
     pub out: &'a mut [PairForce],
 }
@@ -45,7 +45,7 @@ pub(super) struct PairSlots<'a> {
 #[inline(never)]
 pub(super) unsafe fn pair_chunk<L: ContactLaw>(
     view: &PairView<'_, L>,
-    arr: &Arrays,
+    arr: &Arrays<L::History>,
     touched: &[AtomicBool],
     c: usize,
     closed: [f64; 3],
@@ -67,7 +67,7 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
         let slots = PairSlots {
             p: arr.p.slice(a..b),
             i: arr.i.slice(a..b),
-            xi: arr.xi.slice_mut(a..b),
+            history: arr.history.slice_mut(a..b),
             active: arr.active.slice_mut(a..b),
             out: arr.out.slice_mut(a..b),
         };
@@ -88,11 +88,12 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
 pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
-    s: PairSlots<'_>,
+    s: PairSlots<'_, L::History>,
 ) {
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
-        pair_force::<L, PERIODIC>(view, p, i, &mut s.xi[k], &mut s.active[k], &mut s.out[k]);
+        let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
+        pair_force::<L, PERIODIC>(view, p, i, history, active, out);
         if s.active[k] {
             // only free particles gather (and clear their flag)
             for q in [p, i] {
@@ -114,7 +115,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     p: usize,
     i: usize,
-    xi: &mut Vec3,
+    history: &mut L::History,
     active: &mut bool,
     out: &mut PairForce,
 ) {
@@ -128,7 +129,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     if r.norm_squared() >= sum * sum {
         if *active {
             *active = false;
-            *xi = Vec3::zeros();
+            *history = L::History::default();
         }
         return;
     }
@@ -142,7 +143,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         w_i: view.w.get(i),
     };
     if let Some(kin) = input.kinematics() {
-        *out = view.law.evaluate(&kin, xi, view.dt);
+        *out = view.law.evaluate(&kin, history, view.dt);
         *active = true;
     }
 }

@@ -27,9 +27,9 @@ pub(super) struct Kick<'a> {
 /// during the call; with `kick_end`, every pair chunk holding a pair of these particles is done
 /// and no thread writes those pairs' slots.
 #[inline(never)]
-pub(super) unsafe fn particle_pass<const ROT: bool, const GRAV: bool>(
+pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     k: &Kick<'_>,
-    arr: &Arrays,
+    arr: &Arrays<H>,
     a: usize,
     b: usize,
     kick_end: bool,
@@ -145,7 +145,7 @@ pub(super) unsafe fn particle_pass<const ROT: bool, const GRAV: bool>(
 /// # Safety
 /// `arr` is valid and no thread writes the slots of `a`'s pairs during the call.
 #[inline(always)]
-pub(super) unsafe fn gather(a: usize, arr: &Arrays) -> (Vec3, Vec3) {
+pub(super) unsafe fn gather<H>(a: usize, arr: &Arrays<H>) -> (Vec3, Vec3) {
     let mut f = Vec3::zeros();
     let mut t = Vec3::zeros();
     let (s, e) = (

@@ -38,6 +38,7 @@ use self::forces::{pair_chunk, pair_force, PairView};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState};
+use crate::state::{History, Snapshot};
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
@@ -45,25 +46,71 @@ use counters::Laps;
 /// A simulation: the state and the contact law that advances it.
 pub struct Simulation<L: ContactLaw> {
     pub law: L,
-    pub core: Core,
+    pub core: Core<L::History>,
 }
 
 /// The law-independent face of a simulation, for the run loop and the tools.
 pub trait Engine: Send {
-    /// The state and settings the law does not own.
-    fn core(&self) -> &Core;
+    /// The dynamic state (particles in memory order; see [`Engine::snapshot`]).
+    fn state(&self) -> &State;
+    /// The settings of the step.
+    fn params(&self) -> &Params;
     /// The same, to change between calls of [`Engine::advance`].
-    fn core_mut(&mut self) -> &mut Core;
+    fn params_mut(&mut self) -> &mut Params;
+    /// Time per stage and rebuilds since the counters were last reset.
+    fn counters(&self) -> &StageTimes;
+    /// The same, to reset.
+    fn counters_mut(&mut self) -> &mut StageTimes;
+    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
+    fn snapshot(&self) -> Snapshot;
+    /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
+    /// carry this law's history ([`Engine::history_words`] words each).
+    fn restore(&mut self, snap: &Snapshot);
+    /// Words of the canonical form of the contact law's history.
+    fn history_words(&self) -> usize;
+    /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
+    fn rebuild(&mut self);
+    /// Number of pairs in contact at the last force evaluation.
+    fn contact_count(&self) -> usize;
+    /// Number of candidate pairs at the last build.
+    fn pair_count(&self) -> usize;
     /// Advances `steps` time steps (evaluating the initial forces first if needed).
     fn advance(&mut self, steps: u64);
 }
 
 impl<L: ContactLaw> Engine for Simulation<L> {
-    fn core(&self) -> &Core {
-        &self.core
+    fn state(&self) -> &State {
+        &self.core.state
     }
-    fn core_mut(&mut self) -> &mut Core {
-        &mut self.core
+    fn params(&self) -> &Params {
+        &self.core.params
+    }
+    fn params_mut(&mut self) -> &mut Params {
+        &mut self.core.params
+    }
+    fn counters(&self) -> &StageTimes {
+        &self.core.counters
+    }
+    fn counters_mut(&mut self) -> &mut StageTimes {
+        &mut self.core.counters
+    }
+    fn snapshot(&self) -> Snapshot {
+        self.core.snapshot()
+    }
+    fn restore(&mut self, snap: &Snapshot) {
+        self.core.restore(snap)
+    }
+    fn history_words(&self) -> usize {
+        <L::History as History>::WORDS
+    }
+    fn rebuild(&mut self) {
+        self.core.rebuild()
+    }
+    fn contact_count(&self) -> usize {
+        self.core.contact_count()
+    }
+    fn pair_count(&self) -> usize {
+        self.core.pair_count()
     }
     fn advance(&mut self, steps: u64) {
         if !self.core.state.forces_ready {
@@ -80,34 +127,21 @@ impl<L: ContactLaw> Engine for Simulation<L> {
 
 impl<L: ContactLaw> Simulation<L> {
     /// A simulation of `core` under the contact law `law`.
-    pub fn new(law: L, core: Core) -> Self {
+    pub fn new(law: L, core: Core<L::History>) -> Self {
         Simulation { law, core }
     }
 
     /// MercuryDPM evaluates the forces once before the first step, at x_0 with v_0.
     fn initial_forces(&mut self) {
         self.core.rebuild();
-        let Core {
-            state,
-            params,
-            work,
-            ..
-        } = &mut self.core;
+        let params = &self.core.params;
         let dt = if params.setup_advances_history {
             params.dt
         } else {
             0.0
         };
-        let domain = state.domain.clone();
-        let mut list = rebuild::ListState {
-            particles: &mut state.particles,
-            id: &mut state.id,
-            pairs: &mut state.pairs,
-            builder: &mut work.builder,
-            plan: &mut work.plan,
-            flags: &mut work.flags,
-        };
-        let arr = Arrays::of(&mut list);
+        let domain = self.core.state.domain.clone();
+        let arr = Arrays::of(&mut self.core.list_state());
         let n = arr.x.len();
         // SAFETY: one thread; the views were just taken and nothing else touches the arrays.
         unsafe {
@@ -123,8 +157,9 @@ impl<L: ContactLaw> Simulation<L> {
             };
             for k in 0..arr.p.len() {
                 let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
-                let (xi, active, out) = (arr.xi.at_mut(k), arr.active.at_mut(k), arr.out.at_mut(k));
-                pair_force::<L, true>(&view, p, i, xi, active, out);
+                let history = arr.history.at_mut(k);
+                let (active, out) = (arr.active.at_mut(k), arr.out.at_mut(k));
+                pair_force::<L, true>(&view, p, i, history, active, out);
             }
             for a in 0..n {
                 let (f, t) = gather(a, &arr);
@@ -132,7 +167,7 @@ impl<L: ContactLaw> Simulation<L> {
                 *arr.t.at_mut(a) = t;
             }
         }
-        state.forces_ready = true;
+        self.core.state.forces_ready = true;
     }
 
     /// Advances `steps` steps on the team: every thread runs [`Worker::run`].
@@ -140,25 +175,23 @@ impl<L: ContactLaw> Simulation<L> {
         if steps == 0 {
             return;
         }
-        let Core {
-            state,
-            params,
-            counters,
-            work,
-        } = &mut self.core;
-        let threads = params.threads;
-        let chunks = work.plan.chunks();
-        let bound = work.moved_bound;
-        let skin = work.builder.skin;
+        let core = &mut self.core;
+        let threads = core.params.threads;
+        let chunks = core.work.plan.chunks();
+        let bound = core.work.moved_bound;
+        let skin = core.work.builder.skin;
         // Velocities or forces may have been set since the last run.
-        work.flags.quiet.fill(false);
-        work.plan.reset_live();
-        let domain = state.domain.clone();
-        let mut list = core::list_state(state, work);
+        core.work.flags.quiet.fill(false);
+        core.work.plan.reset_live();
+        let domain = core.state.domain.clone();
+        let params = &core.params;
+        let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
+        let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
+        let mut list = core.list_state();
         let arrays = Shared::new(Arrays::of(&mut list));
         let team = Team {
             threads,
-            bind: params.bind && threads > 1,
+            bind: bind && threads > 1,
             barrier: SpinBarrier::new(threads),
             speeds: (0..threads)
                 .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
@@ -169,12 +202,12 @@ impl<L: ContactLaw> Simulation<L> {
             rebuild_queue: WorkQueue::new(threads, chunks),
             list: Shared::new(list),
             arrays,
-            meet: params.meet.clone(),
+            meet,
             law: &self.law,
             kick: Kick {
                 domain: &domain,
-                dt: params.dt,
-                gravity: params.gravity.unwrap_or_else(Vec3::zeros),
+                dt,
+                gravity,
             },
             skin,
         };
@@ -191,18 +224,19 @@ impl<L: ContactLaw> Simulation<L> {
             })
         };
         drop(team);
-        counters.add_times(&local);
-        counters.rebuilds += local.rebuilds;
-        work.moved_bound = bound;
+        let core = &mut self.core;
+        core.counters.add_times(&local);
+        core.counters.rebuilds += local.rebuilds;
+        core.work.moved_bound = bound;
         for _ in 0..steps {
-            state.time += params.dt;
+            core.state.time += dt;
         }
-        state.step += steps;
+        core.state.step += steps;
     }
 }
 
 /// What the threads of a run share.
-struct Team<'a, L> {
+struct Team<'a, L: ContactLaw> {
     threads: usize,
     bind: bool,
     barrier: SpinBarrier,
@@ -214,8 +248,8 @@ struct Team<'a, L> {
     /// Each pair chunk's last step done, for the gathers that wait for it.
     pairs_done: Marks,
     rebuild_queue: WorkQueue,
-    list: Shared<ListState<'a>>,
-    arrays: Shared<Arrays>,
+    list: Shared<ListState<'a, L::History>>,
+    arrays: Shared<Arrays<L::History>>,
     meet: Option<MeetHook>,
     law: &'a L,
     kick: Kick<'a>,
@@ -223,11 +257,11 @@ struct Team<'a, L> {
 }
 
 /// One thread of a run: its share of every stage, and its own counters.
-struct Worker<'t, 'a, L> {
+struct Worker<'t, 'a, L: ContactLaw> {
     team: &'t Team<'a, L>,
     tid: usize,
     /// Views of the shared arrays, refreshed after every rebuild.
-    arr: Arrays,
+    arr: Arrays<L::History>,
     /// Displacement bounds since the last build of a slow [0] and a fast [1] particle (length).
     bound: [f64; 2],
     times: StageTimes,
@@ -291,7 +325,14 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                     let w = team.pairs_done.wait(first as usize..end as usize, round);
                     waited += w.as_nanos() as u64;
                 }
-                particle_pass::<ROT, GRAV>(&team.kick, &self.arr, a, b, gather.is_some(), drift)
+                particle_pass::<L::History, ROT, GRAV>(
+                    &team.kick,
+                    &self.arr,
+                    a,
+                    b,
+                    gather.is_some(),
+                    drift,
+                )
             };
             for (m, s) in v2.iter_mut().zip(seen) {
                 *m = m.max(s);
@@ -402,27 +443,39 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
 
 #[cfg(test)]
 mod tests {
+    use super::{Core, Simulation};
     use crate::case::Case;
-    use crate::engine::{self, Overrides};
+    use crate::contact::ContactLaw;
+    use crate::engine::{self, LawVisitor};
+    use crate::neighbor::NeighborBuilder;
+    use crate::scene::Scene;
     use std::path::Path;
 
-    /// The live prefix of every class of every pair chunk holds only pairs whose build gap the
-    /// particles can have closed since the build (to within a gap bin), also after a rebuild
-    /// inside a run. Runs of several lengths from MercuryDPM's developed state end at different
-    /// distances from their last rebuild, so some end soon after one.
-    #[test]
-    fn after_a_rebuild_the_pair_pass_visits_only_pairs_within_reach() {
-        let case = Case::load(Path::new("cases/shear_flow_quick.toml")).unwrap();
-        let state = Path::new("data/states/mercury_t143.85.data");
-        for steps in [800, 1000, 1200, 1400] {
-            let scene = crate::scene::build(&case, Some(state)).unwrap();
-            let o = Overrides {
-                threads: Some(1),
-                ..Overrides::default()
-            };
-            let mut e = engine::build(&case, scene, &o);
-            e.advance(steps);
-            let c = e.core();
+    /// Runs `steps` steps of the scene on one thread under the case's law, then checks the
+    /// live prefixes of the pair chunks.
+    struct RunAndCheck {
+        scene: Scene,
+        dt: f64,
+        skin: f64,
+        search: crate::neighbor::Search,
+        steps: u64,
+    }
+
+    impl LawVisitor for RunAndCheck {
+        type Output = ();
+        fn visit<L: ContactLaw + Clone + 'static>(self, law: L) {
+            let builder = NeighborBuilder::new(self.skin, 0.0, 0.5, self.search);
+            let core = Core::new(
+                self.scene.domain,
+                self.scene.particles,
+                self.dt,
+                None,
+                builder,
+                1,
+            );
+            let mut sim = Simulation::new(law, core);
+            super::Engine::advance(&mut sim, self.steps);
+            let (c, steps) = (&sim.core, self.steps);
             assert!(c.counters.rebuilds >= 2, "no rebuild inside the run");
             let closed = super::gap_closed(c.work.moved_bound);
             let width = c.skin() / 16.0;
@@ -439,6 +492,26 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The live prefix of every class of every pair chunk holds only pairs whose build gap the
+    /// particles can have closed since the build (to within a gap bin), also after a rebuild
+    /// inside a run. Runs of several lengths from MercuryDPM's developed state end at different
+    /// distances from their last rebuild, so some end soon after one.
+    #[test]
+    fn after_a_rebuild_the_pair_pass_visits_only_pairs_within_reach() {
+        let case = Case::load(Path::new("cases/shear_flow_quick.toml")).unwrap();
+        let state = Path::new("data/states/mercury_t143.85.data");
+        for steps in [800, 1000, 1200, 1400] {
+            let run = RunAndCheck {
+                scene: crate::scene::build(&case, Some(state)).unwrap(),
+                dt: case.dt(),
+                skin: case.neighbor.skin,
+                search: case.neighbor.search,
+                steps,
+            };
+            engine::with_law(&case.contact, run);
         }
     }
 }

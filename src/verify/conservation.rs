@@ -60,7 +60,7 @@ pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
     let sc = scene::build(case, None)?;
     let mut e = engine::build(case, sc, &Overrides::default());
     e.advance(0);
-    let first = e.core().snapshot();
+    let first = e.snapshot();
     let (e0, p0, _) = totals(&first, case.contact.kn);
     let mass: f64 = first.particles.inv_mass.iter().map(|im| 1.0 / im).sum();
     let v_rms = (2.0 * e0 / mass).sqrt();
@@ -71,7 +71,7 @@ pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
         let n = every.min(steps - done);
         e.advance(n);
         done += n;
-        let (en, p, _) = totals(&e.core().snapshot(), case.contact.kn);
+        let (en, p, _) = totals(&e.snapshot(), case.contact.kn);
         let rel = (en - e0) / e0;
         deviation = deviation.max(rel.abs());
         dp = dp.max((p - p0).norm() / (mass * v_rms));
@@ -117,7 +117,7 @@ pub fn cluster(case: &Case) -> Scene {
 pub fn cluster_angular_momentum(case: &Case, steps: u64) -> f64 {
     let mut e = engine::build(case, cluster(case), &Overrides::default());
     e.advance(0);
-    let first = e.core().snapshot();
+    let first = e.snapshot();
     let (_, _, l0) = totals(&first, case.contact.kn);
     let p = &first.particles;
     let scale: f64 = (0..p.len())
@@ -127,7 +127,7 @@ pub fn cluster_angular_momentum(case: &Case, steps: u64) -> f64 {
         })
         .sum();
     e.advance(steps);
-    let (_, _, l1) = totals(&e.core().snapshot(), case.contact.kn);
+    let (_, _, l1) = totals(&e.snapshot(), case.contact.kn);
     (l1 - l0).norm() / scale
 }
 

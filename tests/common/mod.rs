@@ -51,7 +51,7 @@ pub fn engine(case: &Case, init: Option<&Path>, o: Overrides) -> Box<dyn Engine>
 /// State hash after `steps` steps.
 pub fn hash_after(engine: &mut dyn Engine, steps: u64) -> String {
     engine.advance(steps);
-    verdem::io::hash::state_hash(&engine.core().snapshot())
+    verdem::io::hash::state_hash(&engine.snapshot())
 }
 
 /// Runs `engine` to step `end_step` with a save every `save_every` into `dir`, saves named
