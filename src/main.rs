@@ -191,7 +191,11 @@ enum Command {
     },
     /// List the known peers, one a line, tab-separated: name, binary, tangential convention,
     /// the command of a 1-process run, installed version.
-    Peers,
+    Peers {
+        /// Only these peers, comma-separated (an unknown name is an error).
+        #[arg(default_value_t = verdem::peers::names())]
+        names: String,
+    },
     /// The speed/accuracy trade: the case under variants (dt, softer contacts, skin, threads)
     /// from the same state for the same simulated time; cost, restitution error and the
     /// deviation of each profile from the reference in units of its standard error.
@@ -669,7 +673,10 @@ fn real_main() -> anyhow::Result<Finished> {
                 println!("(overlay in {})", png.display());
             }
         }
-        Command::Peers => print!("{}", verdem::peers::listing(verdem::peers::all())),
+        Command::Peers { names } => print!(
+            "{}",
+            verdem::peers::listing(&verdem::peers::parse_list(&names)?)
+        ),
         Command::Tradeoff {
             case,
             from,

@@ -26,7 +26,8 @@ fn generated_inputs_are_those_of_the_recorded_cross_runs() {
     }
 }
 
-/// `verdem peers` lists every known peer; a name it does not know is refused with the list.
+/// `verdem peers` lists every known peer, or those named; a name it does not know is refused
+/// with the list.
 #[test]
 fn the_command_line_knows_the_peers_of_the_registry() {
     let out = common::verdem_ok(["peers"]);
@@ -40,9 +41,12 @@ fn the_command_line_knows_the_peers_of_the_registry() {
         text.starts_with("lammps\tlmp\tlammps-granular\tmpirun --allow-run-as-root --oversubscribe -np 1 lmp -in in.lmp -log none\tlammps "),
         "{text}"
     );
+    let out = common::verdem_ok(["peers", "liggghts"]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("liggghts\tliggghts\tliggghts\t"));
     for args in [
         &["cross", "yade"][..],
         &["verify", "--peers", "lammps,yade"],
+        &["peers", "liggghts,yade"],
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
             .args(args)
