@@ -233,7 +233,7 @@ fn hinges(mut r: Vec<f64>) -> (f64, f64) {
 /// The speed-up of 2 threads over 1 asked of verdem; the table counts the rounds that reach it.
 const SPEEDUP_GOAL: f64 = 1.7;
 
-/// How many times a peer's rate on 2 ranks asked of verdem on 2 threads.
+/// The rate on 2 threads asked of verdem, in multiples of a peer's rate on 2 ranks.
 const PEER_GOAL: f64 = 5.0;
 
 /// The confidence of the interval [`median_interval`] gives.

@@ -1,14 +1,14 @@
-//! Cross-runs: a peer and verdem on the same case, from the same state, for
-//! the same steps, compared particle by particle at every save.
+//! Cross-runs: a peer and verdem on the same case, from the same state, for the same steps,
+//! compared particle by particle at every save.
 //!
 //! verdem runs with the peer's tangential convention ([`Peer::convention`]: LAMMPS `granular …
 //! linear_history` → `lammps-granular`, LIGGGHTS `tangential history` → `liggghts`), so that
-//! the two codes integrate the same equations; what remains is the summation order of forces, so the
-//! trajectories agree to round-off at first and part by chaos later. The step at which the
-//! largest position difference first exceeds 1e-6 measures that onset. Both series are written
-//! as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact dumps),
-//! coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`, overlaid in
-//! `profiles.png`, and compared profile by profile (χ²/dof).
+//! the two codes integrate the same equations; what remains is the summation order of forces,
+//! so the trajectories agree to round-off at first and part by chaos later. The step at which
+//! the largest position difference first exceeds 1e-6 measures that onset. Both series are
+//! written as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact
+//! dumps), coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`,
+//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof).
 
 use std::fmt::Write;
 use std::path::Path;

@@ -23,7 +23,7 @@ use crate::sim::{Contact, Snapshot};
 use crate::Vec3;
 
 /// Every known peer, in the order of listings and default runs. A new peer is one line here.
-static ALL: [&dyn Peer; 2] = [&lammps::Lammps, &liggghts::Liggghts];
+static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts];
 
 /// A peer code: how it is installed and started, how it reads verdem's cases and states, and
 /// how its saves are read back.
@@ -111,22 +111,24 @@ pub struct Frame {
 
 /// Every known peer.
 pub fn all() -> &'static [&'static dyn Peer] {
-    &ALL
+    ALL
 }
 
 /// The names of all known peers, comma-separated (`lammps,liggghts`).
 pub fn names() -> String {
-    ALL.map(|p| p.name()).join(",")
+    known(",")
+}
+
+/// The names of all known peers, joined by `sep`.
+fn known(sep: &str) -> String {
+    ALL.iter().map(|p| p.name()).collect::<Vec<_>>().join(sep)
 }
 
 /// The peer named `name`; the error lists the known names.
 pub fn by_name(name: &str) -> anyhow::Result<&'static dyn Peer> {
     match ALL.iter().find(|p| p.name() == name) {
         Some(p) => Ok(*p),
-        None => bail!(
-            "unknown peer {name:?} (known: {})",
-            ALL.map(|p| p.name()).join(", ")
-        ),
+        None => bail!("unknown peer {name:?} (known: {})", known(", ")),
     }
 }
 
