@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Records golden/peers/: LAMMPS and LIGGGHTS (Debian packages, 1 MPI rank each, both at once)
-# run the shear case from verdem's steady state golden/full_run/shear_flow.final.data, a save
-# every 50000 steps; verdem converts their dumps into MercuryCG saves and coarse-grains them,
-# and runs the same steps in each peer's convention (`verdem cross`). Then verdem itself (its
-# default, MercuryDPM's convention, 2 threads) runs the same case from the same state for the
-# same steps. Kept, with provenance: each series' profiles (all saves, 10 blocks) and cg checks,
-# the peers' input scripts and cross-run tables, verdem's diagnostics, the comparison table
-# (compare.md) and one overlay of the three codes (profiles.png). About 70 minutes of the
-# machine for 1e7 steps.
+# Records golden/peers/: the peers named as arguments (default: every peer `verdem peers` lists;
+# LAMMPS and LIGGGHTS, Debian packages), 1 MPI rank each, all at once, run the shear case from
+# verdem's steady state golden/full_run/shear_flow.final.data, a save every 50000 steps; verdem
+# converts their dumps into MercuryCG saves and coarse-grains them, and runs the same steps in
+# each peer's convention (`verdem cross`). Then verdem itself (its default, MercuryDPM's
+# convention, 2 threads) runs the same case from the same state for the same steps. Kept, with
+# provenance: each series' profiles (all saves, 10 blocks) and cg checks, the peers' input
+# scripts and cross-run tables, verdem's diagnostics, the comparison table (compare.md, every
+# peer recorded in golden/peers/) and one overlay of the codes (profiles.png). About 70 minutes
+# of the machine for 1e7 steps.
+#   ci/record_peers.sh [PEER ...]
 #   STEPS=N   steps of each run (default 10000000)
 #   STATE=F   the start state (default: the full run's final state)
 set -euo pipefail
@@ -23,7 +25,19 @@ mkdir -p "$G" "$OUT"
 BIN="$OUT/verdem"
 cp target/release/verdem "$BIN"
 START_SHA=$(sha256sum "$STATE" | cut -d' ' -f1)
-for peer in lammps liggghts; do
+# each peer's line of `verdem peers` (an unknown name stops here, with the known ones):
+# name, binary, tangential convention, command of a 1-rank run, installed version
+if [ $# -gt 0 ]; then LIST=$("$BIN" peers "$(IFS=,; echo "$*")"); else LIST=$("$BIN" peers); fi
+declare -A BINARY CONVENTION COMMAND VERSION
+PEERS=()
+while IFS=$'\t' read -r name bin convention command version; do
+  PEERS+=("$name")
+  BINARY[$name]=$bin
+  CONVENTION[$name]=$convention
+  COMMAND[$name]=$command
+  VERSION[$name]=$version
+done <<< "$LIST"
+for peer in "${PEERS[@]}"; do
   "$BIN" cross "$peer" cases/shear_flow.toml --from "$STATE" \
     --steps "$STEPS" --every 50000 --np 1 --out "$OUT" > "$OUT/$peer.log" 2>&1 &
 done
@@ -33,8 +47,8 @@ checks() {
   "$BIN" cg "$1" --from 0 --case cases/shear_flow.toml > /dev/null
   cp "$1.checks.txt" "$2"
 }
-for peer in lammps liggghts; do
-  bin=$([ "$peer" = lammps ] && echo lmp || echo liggghts)
+for peer in "${PEERS[@]}"; do
+  bin=${BINARY[$peer]}
   dir="$OUT/$bin"
   cp "$dir/$bin.profiles.csv" "$G/$peer.profiles.csv"
   cp "$dir/verdem.profiles.csv" "$G/verdem_as_$peer.profiles.csv"
@@ -45,10 +59,10 @@ for peer in lammps liggghts; do
   cat > "$G/$peer.toml" <<TOML
 # How golden/peers/$peer.* and verdem_as_$peer.* were made (written by ci/record_peers.sh).
 peer = "$peer"
-package = "$peer $(dpkg-query -W -f='${Version}' "$peer")"
+package = "${VERSION[$peer]}"
 command = "verdem cross $peer cases/shear_flow.toml --from $STATE --steps $STEPS --every 50000 --np 1"
-peer_command = "mpirun --allow-run-as-root -np 1 $bin -in in.$bin -log none"
-verdem_as_peer = "verdem, 1 thread, tangential convention $([ "$peer" = lammps ] && echo lammps-granular || echo liggghts), no history update at setup (as the peer)"
+peer_command = "${COMMAND[$peer]}"
+verdem_as_peer = "verdem, 1 thread, tangential convention ${CONVENTION[$peer]}, no history update at setup (as the peer)"
 start_state_sha256 = "$START_SHA"
 steps = $STEPS
 every = 50000
@@ -76,15 +90,30 @@ commit = "$COMMIT"
 recorded = "$(date -u +%Y-%m-%dT%H:%M:%SZ)"
 profiles = "verdem.profiles.csv: all saves 0..$((STEPS / 50000)), 100 slices, Heaviside kernel, 10 blocks"
 TOML
+# every peer of verdem's list with a recording in golden/peers/, in the list's order; labels
+# are the names in capitals
+RECORDED=()
+for peer in $("$BIN" peers | cut -f1); do
+  [ -f "$G/$peer.profiles.csv" ] && RECORDED+=("$peer")
+done
+tables=() labels=verdem
+for peer in "${RECORDED[@]}"; do
+  tables+=("$G/$peer.profiles.csv")
+  labels+=",${peer^^}"
+done
+as_tables=() as_labels=
+for peer in "${RECORDED[@]}"; do
+  as_tables+=("$G/verdem_as_$peer.profiles.csv")
+  as_labels+=",verdem as ${peer^^}"
+done
 {
   echo "# The long runs of golden/peers compared (written by ci/record_peers.sh)"
   echo
   echo "## Each code against verdem (MercuryDPM's convention)"
   echo
-  "$BIN" compare "$G/verdem.profiles.csv" "$G/lammps.profiles.csv" "$G/liggghts.profiles.csv" \
-    "$G/verdem_as_lammps.profiles.csv" "$G/verdem_as_liggghts.profiles.csv" \
-    --labels verdem,LAMMPS,LIGGGHTS,"verdem as LAMMPS","verdem as LIGGGHTS"
-  for peer in lammps liggghts; do
+  "$BIN" compare "$G/verdem.profiles.csv" "${tables[@]}" "${as_tables[@]}" \
+    --labels "$labels$as_labels"
+  for peer in "${RECORDED[@]}"; do
     echo
     echo "## $peer against verdem in $peer's convention (the same equations: noise alone)"
     echo
@@ -92,6 +121,6 @@ TOML
       --labels "$peer","verdem as $peer"
   done
 } > "$G/compare.md"
-"$BIN" compare "$G/verdem.profiles.csv" "$G/lammps.profiles.csv" "$G/liggghts.profiles.csv" \
-  --labels verdem,LAMMPS,LIGGGHTS --plot "$G/profiles.png" > /dev/null
+"$BIN" compare "$G/verdem.profiles.csv" "${tables[@]}" \
+  --labels "$labels" --plot "$G/profiles.png" > /dev/null
 echo "recorded in $G"

@@ -110,9 +110,9 @@ enum Command {
         /// verdem thread counts.
         #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
         threads: Vec<usize>,
-        /// Peers to run (none: --peers '').
-        #[arg(long, value_delimiter = ',', default_value = "lammps,liggghts")]
-        peers: Vec<String>,
+        /// Peers to run, comma-separated (`verdem peers` lists them; none: --peers '').
+        #[arg(long, default_value_t = verdem::peers::names())]
+        peers: String,
         /// MPI ranks for the peers.
         #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
         np: Vec<usize>,
@@ -137,10 +137,10 @@ enum Command {
         /// Only the rows whose case name contains this text.
         #[arg(long)]
         only: Option<String>,
-        /// Also run the binary collisions in these installed peers (lammps, liggghts), against
-        /// the same closed forms.
-        #[arg(long, value_enum, value_delimiter = ',')]
-        peers: Vec<verdem::peers::Peer>,
+        /// Also run the binary collisions in these installed peers (comma-separated names;
+        /// `verdem peers` lists them), against the same closed forms.
+        #[arg(long, value_parser = verdem::peers::by_name, value_delimiter = ',')]
+        peers: Vec<&'static dyn verdem::peers::Peer>,
         /// Where the peers' collision runs go.
         #[arg(long, default_value = "out/verify")]
         out: PathBuf,
@@ -166,9 +166,9 @@ enum Command {
     /// case and state; compare positions, velocities and spins at every save; write both
     /// series as MercuryCG saves and the table as OUT/cross.md.
     Cross {
-        /// The peer: lammps (`lmp`) or liggghts (`liggghts`), run with mpirun.
-        #[arg(value_enum)]
-        peer: verdem::peers::Peer,
+        /// The peer, by name (`verdem peers` lists them: lammps, liggghts).
+        #[arg(value_parser = verdem::peers::by_name)]
+        peer: &'static dyn verdem::peers::Peer,
         /// Case file (default: cases/shear_flow_quick.toml).
         #[arg(default_value = "cases/shear_flow_quick.toml")]
         case: PathBuf,
@@ -189,6 +189,13 @@ enum Command {
         /// convention changes).
         #[arg(long, value_enum)]
         convention: Option<verdem::case::Tangential>,
+    },
+    /// List the known peers, one a line, tab-separated: name, binary, tangential convention,
+    /// the command of a 1-process run, installed version.
+    Peers {
+        /// Only these peers, comma-separated (an unknown name is an error).
+        #[arg(default_value_t = verdem::peers::names())]
+        names: String,
     },
     /// The speed/accuracy trade: the case under variants (dt, softer contacts, skin, threads)
     /// from the same state for the same simulated time; cost, restitution error and the
@@ -560,12 +567,7 @@ fn real_main() -> anyhow::Result<Finished> {
                     lockstep,
                 }));
             }
-            for name in peers.iter().filter(|p| !p.is_empty()) {
-                let peer = match name.as_str() {
-                    "lammps" => verdem::peers::Peer::Lammps,
-                    "liggghts" => verdem::peers::Peer::Liggghts,
-                    other => anyhow::bail!("--peers: unknown peer {other:?} (lammps, liggghts)"),
-                };
+            for peer in verdem::peers::parse_list(&peers).context("--peers")? {
                 configs.extend(np.iter().map(|&n| bench::Config::Peer { peer, np: n }));
             }
             let measured = bench::run(&case, &from, steps, &configs, rounds, &out)?;
@@ -635,7 +637,7 @@ fn real_main() -> anyhow::Result<Finished> {
         } => {
             let case = Case::load(&case)?;
             let out = out.join(peer.binary());
-            let convention = convention.unwrap_or(verdem::peers::cross::convention_of(peer));
+            let convention = convention.unwrap_or(peer.convention());
             let report = verdem::peers::cross::cross(
                 peer, &case, convention, &from, steps, every, np, &out,
             )?;
@@ -672,6 +674,10 @@ fn real_main() -> anyhow::Result<Finished> {
                 println!("(overlay in {})", png.display());
             }
         }
+        Command::Peers { names } => print!(
+            "{}",
+            verdem::peers::listing(&verdem::peers::parse_list(&names)?)
+        ),
         Command::Tradeoff {
             case,
             from,

@@ -4,7 +4,63 @@
 mod common;
 
 use verdem::engine::Overrides;
-use verdem::peers::{self, Peer};
+use verdem::peers::{self, lammps_family::data_file, Peer};
+
+/// LAMMPS and LIGGGHTS, from the registry.
+fn lammps_and_liggghts() -> [&'static dyn Peer; 2] {
+    ["lammps", "liggghts"].map(|name| peers::by_name(name).unwrap())
+}
+
+/// The generated input of the long cross-runs is byte for byte the one golden/peers/ recorded
+/// with (`ci/record_peers.sh`: the full case, a dump every 50000 steps, from `state.lmp`).
+#[test]
+fn generated_inputs_are_those_of_the_recorded_cross_runs() {
+    let case = verdem::case::Case::load(&common::root().join("cases/shear_flow.toml")).unwrap();
+    for peer in lammps_and_liggghts() {
+        let recorded = common::root().join(format!("golden/peers/{}.in", peer.name()));
+        let recorded = std::fs::read_to_string(&recorded).unwrap();
+        let script = peer
+            .input_script(&case, "state.lmp", 10_000_000, Some(50_000))
+            .unwrap();
+        assert_eq!(script, recorded, "{peer:?}");
+    }
+}
+
+/// `verdem peers` lists every known peer, or those named; a name it does not know is refused
+/// with the list.
+#[test]
+fn the_command_line_knows_the_peers_of_the_registry() {
+    let out = common::verdem_ok(["peers"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let names: Vec<&str> = text
+        .lines()
+        .map(|l| l.split('\t').next().unwrap())
+        .collect();
+    assert_eq!(names, ["lammps", "liggghts"], "{text}");
+    assert!(
+        text.starts_with("lammps\tlmp\tlammps-granular\tmpirun --allow-run-as-root --oversubscribe -np 1 lmp -in in.lmp -log none\tlammps "),
+        "{text}"
+    );
+    let out = common::verdem_ok(["peers", "liggghts"]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("liggghts\tliggghts\tliggghts\t"));
+    for args in [
+        &["cross", "yade"][..],
+        &["verify", "--peers", "lammps,yade"],
+        &["peers", "liggghts,yade"],
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+            .args(args)
+            .current_dir(common::root())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(
+            err.contains("unknown peer \"yade\" (known: lammps, liggghts)"),
+            "{args:?}: {err}"
+        );
+    }
+}
 
 #[test]
 fn lammps_and_liggghts_run_the_generated_inputs() {
@@ -16,12 +72,14 @@ fn lammps_and_liggghts_run_the_generated_inputs() {
     );
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("state.lmp");
-    std::fs::write(&data, peers::data_file(&e.snapshot(), 1.0)).unwrap();
-    for peer in [Peer::Lammps, Peer::Liggghts] {
-        let script =
-            peers::input_script(peer, &case, &data.display().to_string(), 200, None).unwrap();
+    std::fs::write(&data, data_file(&e.snapshot(), 1.0)).unwrap();
+    for peer in lammps_and_liggghts() {
+        let script = peer
+            .input_script(&case, &data.display().to_string(), 200, None)
+            .unwrap();
         for np in [1, 2] {
-            let seconds = peers::run(peer, np, dir.path(), &script)
+            let seconds = peer
+                .run(np, dir.path(), &script)
                 .unwrap_or_else(|e| panic!("{peer:?} on {np} rank(s): {e:#}"));
             assert!(
                 seconds > 0.0 && seconds.is_finite(),
@@ -40,7 +98,7 @@ fn data_file_carries_every_particle_with_its_type_and_velocity() {
         Overrides::default(),
     );
     let snap = e.snapshot();
-    let text = peers::data_file(&snap, 1.0);
+    let text = data_file(&snap, 1.0);
     let atoms: Vec<&str> = text
         .split("Atoms # sphere\n\n")
         .nth(1)
@@ -71,13 +129,13 @@ fn data_file_carries_every_particle_with_its_type_and_velocity() {
 /// the 1e-6 that marks divergence; with MercuryDPM's convention instead, they do not.
 #[test]
 fn cross_runs_agree_to_round_off_with_the_peers_convention_and_not_without() {
-    use verdem::peers::cross::{convention_of, cross};
+    use verdem::peers::cross::cross;
     let case = common::quick_case();
     let state = common::data("states/mercury_t143.85.data");
     let dir = tempfile::tempdir().unwrap();
-    for peer in [Peer::Lammps, Peer::Liggghts] {
+    for peer in lammps_and_liggghts() {
         let out = dir.path().join(peer.binary());
-        let r = cross(peer, &case, convention_of(peer), &state, 2000, 500, 1, &out)
+        let r = cross(peer, &case, peer.convention(), &state, 2000, 500, 1, &out)
             .unwrap_or_else(|e| panic!("{peer:?}: {e:#}"));
         assert_eq!(r.saves.len(), 5);
         for s in &r.saves {
@@ -114,7 +172,7 @@ fn cross_runs_agree_to_round_off_with_the_peers_convention_and_not_without() {
     }
     let out = dir.path().join("mismatched");
     let r = cross(
-        Peer::Lammps,
+        peers::by_name("lammps").unwrap(),
         &case,
         verdem::case::Tangential::Mercury,
         &state,
@@ -135,7 +193,7 @@ fn peers_give_the_restitution_of_the_closed_form_and_of_verdem() {
     let case = verdem::case::Case::load(&common::root().join("cases/verify/binary_collision.toml"))
         .unwrap();
     let dir = tempfile::tempdir().unwrap();
-    for peer in [Peer::Lammps, Peer::Liggghts] {
+    for peer in lammps_and_liggghts() {
         let rows = peers::collision::rows(peer, &case, &dir.path().join(peer.binary())).unwrap();
         assert_eq!(rows.len(), 8);
         for r in &rows {

@@ -5,16 +5,15 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::{collision_script, data_file, dump, run, Peer};
+use super::Peer;
 use crate::case::Case;
-use crate::io::atomic;
 use crate::verify::collision::{closed_form, head_on, impact_setup};
 use crate::verify::{row, Row};
 
 /// The restitution coefficient `peer` gives for a head-on collision at speed `v0` (onto a fixed
 /// sphere when `wall`) under `case`'s law at its dt, run in `dir`.
 pub fn restitution(
-    peer: Peer,
+    peer: &dyn Peer,
     case: &Case,
     v0: f64,
     wall: bool,
@@ -27,24 +26,18 @@ pub fn restitution(
     let dt = timed.dt();
     let (timed, e) = impact_setup(&timed, head_on(v0, wall, dt, 0.5), per_tc)?;
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    let data = data_file(&e.snapshot(), case.material.density);
-    atomic::write(&dir.join("pair.lmp"), data.as_bytes())?;
+    let data = peer.write_state(&e.snapshot(), case.material.density, dir, "pair")?;
     // the contact with a fixed sphere lasts tc_fw = √2·tc_ff at most; then free flight
     let tc_fw = closed_form(&timed, timed.particle_mass()).tc;
     let steps = (tc_fw / dt * 1.5).ceil() as u64 + 5;
-    run(
-        peer,
-        1,
-        dir,
-        &collision_script(peer, &timed, "pair.lmp", steps),
-    )?;
-    let end = dump::read(&dir.join(format!("dump.{steps}.txt")))?;
+    peer.run(1, dir, &peer.collision_script(&timed, &data, steps))?;
+    let end = peer.read_frame(dir, steps)?;
     Ok((end.v[1] - end.v[0]).x / v0)
 }
 
 /// Rows of the binary collisions in `peer` against the closed forms, both partners, speeds
 /// 1e-3 … 10, at the case's dt.
-pub fn rows(peer: Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>> {
+pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>> {
     let m = case.particle_mass();
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
     let mut rows = Vec::new();

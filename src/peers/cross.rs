@@ -1,37 +1,26 @@
-//! Cross-runs: a peer (LAMMPS or LIGGGHTS) and verdem on the same case, from the same state, for
-//! the same steps, compared particle by particle at every save.
+//! Cross-runs: a peer and verdem on the same case, from the same state, for the same steps,
+//! compared particle by particle at every save.
 //!
-//! verdem runs with the peer's tangential convention (LAMMPS `granular … linear_history` →
-//! `lammps-granular`, LIGGGHTS `tangential history` → `liggghts`), so that the two codes
-//! integrate the same equations; what remains is the summation order of forces, so the
-//! trajectories agree to round-off at first and part by chaos later. The step at which the
-//! largest position difference first exceeds 1e-6 measures that onset. Both series are written
-//! as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its pair/local dumps),
-//! coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`, overlaid in
-//! `profiles.png`, and compared profile by profile (χ²/dof).
+//! verdem runs with the peer's tangential convention ([`Peer::convention`]: LAMMPS `granular …
+//! linear_history` → `lammps-granular`, LIGGGHTS `tangential history` → `liggghts`), so that
+//! the two codes integrate the same equations; what remains is the summation order of forces,
+//! so the trajectories agree to round-off at first and part by chaos later. The step at which
+//! the largest position difference first exceeds 1e-6 measures that onset. Both series are
+//! written as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact
+//! dumps), coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`,
+//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof).
 
 use std::fmt::Write;
 use std::path::Path;
 
 use anyhow::{ensure, Context};
 
-use super::{dump, input_script, run, Peer};
+use super::Peer;
 use crate::case::{Case, Tangential};
 use crate::cg::{self, table::Table};
-use crate::contact::PairForce;
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
-use crate::state::{Contact, Snapshot};
-use crate::Vec3;
-
-/// The verdem convention that matches `peer`'s contact law.
-pub fn convention_of(peer: Peer) -> Tangential {
-    match peer {
-        Peer::Lammps => Tangential::LammpsGranular,
-        Peer::Liggghts => Tangential::Liggghts,
-    }
-}
 
 /// Largest, median and 99th-percentile value of a sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -69,7 +58,7 @@ pub struct SaveDiff {
 /// A cross-run's outcome.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Report {
-    pub peer: Peer,
+    pub peer: &'static dyn Peer,
     pub np: usize,
     pub convention: Tangential,
     pub saves: Vec<SaveDiff>,
@@ -124,59 +113,15 @@ impl Report {
     }
 }
 
-/// The contacts of a peer's save (its `contacts.STEP.txt`) as verdem contacts of the state `s`:
-/// P the lower index, the force on P. The peers re-evaluate these forces at the end of the step
-/// with full-step velocities in the dashpots (see [`super::input_script`]); their tangential
-/// springs are not dumped, so the `.fstat`'s spring column reads 0.
-fn peer_contacts(peer: Peer, path: &Path, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
-    let columns = match peer {
-        Peer::Lammps => 6,
-        Peer::Liggghts => 5,
-    };
-    let x = &s.particles.x;
-    let mut out = Vec::new();
-    for r in dump::read_entries(path, columns)? {
-        let (a, b) = (r[0] as usize, r[1] as usize);
-        ensure!(
-            (1..=x.len()).contains(&a) && (1..=x.len()).contains(&b),
-            "{}: atom ids {a} {b} out of range",
-            path.display()
-        );
-        let (a, b) = (a - 1, b - 1);
-        let on_a = match peer {
-            // normal force over the distance along x_a − x_b, then the tangential force on a
-            Peer::Lammps => s.domain.min_image(x[a] - x[b]) * r[2] + Vec3::new(r[3], r[4], r[5]),
-            Peer::Liggghts => Vec3::new(r[2], r[3], r[4]),
-        };
-        if on_a == Vec3::zeros() {
-            continue;
-        }
-        let (p, i, f) = if a < b { (a, b, on_a) } else { (b, a, -on_a) };
-        let n = s.domain.min_image(x[p] - x[i]).normalize();
-        out.push(Contact {
-            p: p as u32,
-            i: i as u32,
-            history: Vec::new(),
-            spring: Vec3::zeros(),
-            force: PairForce {
-                f,
-                fn_signed: f.dot(&n),
-                torque_p: Vec3::zeros(),
-                torque_i: Vec3::zeros(),
-            },
-        });
-    }
-    out.sort_unstable_by_key(|c| (c.p, c.i));
-    Ok(out)
-}
-
-/// Runs `peer` on `np` ranks and verdem (one thread per rank, tangential `convention`,
-/// normally [`convention_of`] the peer) on `case` from `state` for `steps` steps, a save every
+/// Runs `peer` on `np` processes and verdem (one thread per process, tangential `convention`,
+/// normally [`Peer::convention`]) on `case` from `state` for `steps` steps, a save every
 /// `every` steps, in `out` (`out/PEER/` holds its data file, input script, dumps and converted
-/// saves; `out/verdem/` verdem's saves).
+/// saves; `out/verdem/` verdem's saves). The peer's contacts in its saves are re-evaluated
+/// at the end of the step and carry no tangential spring ([`Peer::read_contacts`]), so the
+/// `.fstat`'s spring column reads 0.
 #[allow(clippy::too_many_arguments)]
 pub fn cross(
-    peer: Peer,
+    peer: &'static dyn Peer,
     case: &Case,
     convention: Tangential,
     state: &Path,
@@ -196,18 +141,15 @@ pub fn cross(
         ..Overrides::default()
     };
     let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
-    // both peers compute their setup forces without advancing the tangential history
-    // (`update->setupflag`)
-    e.params_mut().setup_advances_history = false;
+    e.params_mut().setup_advances_history = peer.setup_advances_history();
     e.advance(0);
     let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
     for d in [&peer_dir, &own_dir] {
         std::fs::create_dir_all(d).with_context(|| d.display().to_string())?;
     }
-    let data = super::data_file(&e.snapshot(), case.material.density);
-    atomic::write(&peer_dir.join("state.lmp"), data.as_bytes())?;
-    let script = input_script(peer, &case, "state.lmp", steps, Some(every))?;
-    run(peer, np, &peer_dir, &script)?;
+    let data = peer.write_state(&e.snapshot(), case.material.density, &peer_dir, "state")?;
+    let script = peer.input_script(&case, &data, steps, Some(every))?;
+    peer.run(np, &peer_dir, &script)?;
     let mut saves = Vec::new();
     for k in 0..=steps / every {
         if k > 0 {
@@ -218,7 +160,7 @@ pub fn cross(
         atomic::write(&own_dir.join(&name), data_text(&own).as_bytes())?;
         let fstat = format!("{}.fstat.{k:04}", case.name);
         atomic::write(&own_dir.join(&fstat), fstat_text(&own).as_bytes())?;
-        let frame = dump::read(&peer_dir.join(format!("dump.{}.txt", k * every)))?;
+        let frame = peer.read_frame(&peer_dir, k * every)?;
         ensure!(
             frame.x.len() == own.particles.len(),
             "{}: {} atoms, the state has {}",
@@ -232,11 +174,7 @@ pub fn cross(
         theirs.particles.v = frame.v;
         theirs.particles.w = frame.w;
         theirs.particles.radius = frame.radius;
-        theirs.contacts = peer_contacts(
-            peer,
-            &peer_dir.join(format!("contacts.{}.txt", k * every)),
-            &theirs,
-        )?;
+        theirs.contacts = peer.read_contacts(&peer_dir, k * every, &theirs)?;
         atomic::write(&peer_dir.join(&name), data_text(&theirs).as_bytes())?;
         atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
         let (a, b) = (&own.particles, &theirs.particles);

@@ -1,21 +1,13 @@
-//! Reader of the per-save dumps a cross-run asks the peers for (`dump custom … id type radius
-//! x y z vx vy vz omegax omegay omegaz`, sorted by id, 17 significant digits).
+//! Reader of the per-save dumps of the LAMMPS family: particles (`dump custom … id type radius
+//! x y z vx vy vz omegax omegay omegaz`, sorted by id, 17 significant digits) and contacts
+//! (`dump local`).
 
 use std::path::Path;
 
 use super::DUMP_COLUMNS;
 use crate::io::{parse_numbers, read_text, FormatError};
+use crate::peers::Frame;
 use crate::Vec3;
-
-/// One save of a peer: atoms in id order (id 1 first).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    pub step: u64,
-    pub radius: Vec<f64>,
-    pub x: Vec<Vec3>,
-    pub v: Vec<Vec3>,
-    pub w: Vec<Vec3>,
-}
 
 fn err(file: &str, line: usize, msg: impl Into<String>) -> FormatError {
     FormatError {

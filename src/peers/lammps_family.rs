@@ -1,0 +1,374 @@
+//! What LAMMPS and LIGGGHTS share: the data file of a state, the input script's frame, the
+//! dump commands and files of a save, `mpirun` and the "Loop time of" line of the log. A code
+//! of the family is a [`Dialect`]: its names and the lines in which its input differs (units,
+//! atom style, contact law, dump formats, the contact-force columns); every dialect is a
+//! [`Peer`].
+//!
+//! Parameter mapping (LAMMPS docs, `pair_style granular`; LIGGGHTS docs, `gran model
+//! hooke/stiffness`): absolute damping needs `damping velocity` in LAMMPS (the classic
+//! `gran/hooke/history` scales damping by the effective mass and gives a frozen partner its own
+//! mass) and `absolute_damping on` in LIGGGHTS; wall spheres are moved by `fix move linear` and so
+//! act as infinite mass; LIGGGHTS needs `neigh_modify contact_distance_factor 1.01` so that a
+//! tangential spring is reset when its contact ends (`docs/benchmark.md`, known pitfalls).
+
+use std::fmt::Write;
+use std::path::Path;
+use std::process::Command;
+
+use anyhow::{bail, ensure, Context};
+
+pub mod dump;
+
+use super::{wall_speeds, Frame, Peer};
+use crate::case::{Case, Tangential};
+use crate::contact::PairForce;
+use crate::io::atomic;
+use crate::state::Motion;
+use crate::state::{Contact, Snapshot};
+use crate::Vec3;
+
+/// A code of the LAMMPS family: what its input and output have of their own.
+pub trait Dialect: Sync {
+    /// Its name on the command line, lower case; the Debian package it comes from.
+    const NAME: &'static str;
+    /// The installed program.
+    const BINARY: &'static str;
+    /// The verdem convention of its contact law.
+    const CONVENTION: Tangential;
+    /// Numbers per line of its contact dump ([`Dialect::contact_dump`]).
+    const CONTACT_COLUMNS: usize;
+
+    /// The script from its units to its neighbour settings: units, atom style, boundary,
+    /// `read_data data`, the groups ([`GROUPS`]) and the contact law of `case`.
+    fn setup_and_law(case: &Case, data: &str) -> String;
+
+    /// The `dump_modify` keywords that print every float of a [`DUMP_COLUMNS`] line with 17
+    /// significant digits.
+    fn dump_format() -> String;
+
+    /// The commands that dump the contact forces every `every` steps into `contacts.STEP.txt`,
+    /// one line per pair in contact with the two ids first.
+    fn contact_dump(every: u64) -> String;
+
+    /// The force on atom `a` from a line `r` of its contact dump, whose ids are `a` and `b`
+    /// (0-based indices into `s`).
+    fn force_on_first(r: &[f64], s: &Snapshot, a: usize, b: usize) -> Vec3;
+}
+
+/// The groups every input defines: type 1 free, 2 bottom wall, 3 top wall.
+pub const GROUPS: &str =
+    "group           free   type 1\ngroup           bottom type 2\ngroup           top    type 3\n";
+
+/// The columns of a save's particle dump.
+pub const DUMP_COLUMNS: [&str; 12] = [
+    "id", "type", "radius", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
+];
+
+/// The `boundary` arguments of `case`'s domain: `p` periodic, `f` fixed, per axis.
+pub fn boundary(case: &Case) -> String {
+    case.domain
+        .periodic
+        .iter()
+        .map(|p| if *p { "p " } else { "f " })
+        .collect()
+}
+
+/// The neighbour settings: bins of `skin`, rebuilt whenever a sphere moved half of it, no
+/// pairs between wall spheres; `extra` adds `neigh_modify` keywords.
+pub fn neighbor(case: &Case, extra: &str) -> String {
+    format!(
+        "neighbor        {:?} bin\n\
+neigh_modify    delay 0 every 1 check yes{extra} exclude type 2 2 exclude type 3 3 exclude type 2 3\n",
+        case.neighbor.skin
+    )
+}
+
+/// A data file of a state: atom types 1 free, 2 bottom wall, 3 top wall; `Atoms` lines
+/// `id type diameter density x y z` (atom_style sphere / granular), `Velocities` lines
+/// `id vx vy vz wx wy wz`. Numbers round-trip.
+pub fn data_file(s: &Snapshot, density: f64) -> String {
+    let p = &s.particles;
+    let mut out = String::from("verdem state for LAMMPS/LIGGGHTS\n\n");
+    let _ = writeln!(out, "{} atoms\n3 atom types\n", p.len());
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{:?} {:?} {axis}lo {axis}hi",
+            s.domain.lo[k], s.domain.hi[k]
+        );
+    }
+    out.push_str("\nAtoms # sphere\n\n");
+    for a in 0..p.len() {
+        let t = match p.motion[a] {
+            Motion::Free => 1,
+            Motion::Prescribed(0) => 2,
+            Motion::Prescribed(_) => 3,
+        };
+        let x = p.x[a];
+        let _ = writeln!(
+            out,
+            "{} {t} {:?} {density:?} {:?} {:?} {:?}",
+            a + 1,
+            2.0 * p.radius[a],
+            x.x,
+            x.y,
+            x.z
+        );
+    }
+    out.push_str("\nVelocities\n\n");
+    for a in 0..p.len() {
+        let (v, w) = (p.v[a], p.w[a]);
+        let _ = writeln!(
+            out,
+            "{} {:?} {:?} {:?} {:?} {:?} {:?}",
+            a + 1,
+            v.x,
+            v.y,
+            v.z,
+            w.x,
+            w.y,
+            w.z
+        );
+    }
+    out
+}
+
+/// The name a script header gives the code: its name capitalised (`Lammps`).
+fn title<D: Dialect>() -> String {
+    let mut c = D::NAME.chars();
+    c.next()
+        .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
+}
+
+/// The dump a save writes every `every` steps: `dump.STEP.txt`, one file per save, atoms
+/// sorted by id, columns [`DUMP_COLUMNS`], every float with 17 significant digits (round trip),
+/// then the contact dump.
+fn dump_commands<D: Dialect>(every: u64) -> String {
+    format!(
+        "dump            traj all custom {every} dump.*.txt {}\n\
+dump_modify     traj sort id {}\n\
+{}",
+        DUMP_COLUMNS.join(" "),
+        D::dump_format(),
+        D::contact_dump(every)
+    )
+}
+
+/// The free spheres integrated with `nve/sphere`, the dump commands, then the run.
+fn integrate_and_run(dump: &str, steps: u64) -> String {
+    format!(
+        "fix             integ free nve/sphere\n\
+{dump}\
+thermo          {steps}\n\
+run             {steps}\n"
+    )
+}
+
+/// The arguments of `mpirun` that start `binary` on `np` ranks with the script `script`.
+fn mpirun_args(binary: &str, np: usize, script: &str) -> Vec<String> {
+    [
+        "--allow-run-as-root",
+        "--oversubscribe",
+        "-np",
+        &np.to_string(),
+        binary,
+        "-in",
+        script,
+        "-log",
+        "none",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// Runs `binary` on `np` MPI ranks in `dir` with `input` (written to `in.BINARY`); returns the
+/// seconds of its time loop ("Loop time of T on N procs for S steps").
+fn run(binary: &str, package: &str, np: usize, dir: &Path, input: &str) -> anyhow::Result<f64> {
+    let dir = &dir
+        .canonicalize()
+        .with_context(|| dir.display().to_string())?;
+    let script = dir.join(format!("in.{binary}"));
+    std::fs::write(&script, input).with_context(|| script.display().to_string())?;
+    let out = Command::new("mpirun")
+        .args(mpirun_args(binary, np, &script.display().to_string()))
+        .current_dir(dir)
+        .output()
+        .with_context(|| {
+            format!("cannot start mpirun {binary} (install: apt-get install -y {package})")
+        })?;
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        bail!(
+            "{binary} failed ({}):\n{}",
+            out.status,
+            text.lines().rev().take(15).collect::<Vec<_>>().join("\n")
+        );
+    }
+    text.lines()
+        .find_map(|l| {
+            l.strip_prefix("Loop time of ")
+                .and_then(|r| r.split_whitespace().next())
+                .and_then(|t| t.parse().ok())
+        })
+        .with_context(|| format!("{binary}: no 'Loop time' line in its output"))
+}
+
+/// The version of the installed Debian package `package`, after its name.
+fn package_version(package: &str) -> anyhow::Result<String> {
+    let out = Command::new("dpkg-query")
+        .args(["-W", "-f=${Version}", package])
+        .output()
+        .context("cannot start dpkg-query")?;
+    ensure!(
+        out.status.success(),
+        "dpkg-query: {}",
+        String::from_utf8_lossy(&out.stderr).trim()
+    );
+    Ok(format!(
+        "{package} {}",
+        String::from_utf8_lossy(&out.stdout)
+    ))
+}
+
+impl<D: Dialect> Peer for D {
+    fn name(&self) -> &'static str {
+        D::NAME
+    }
+
+    fn binary(&self) -> &'static str {
+        D::BINARY
+    }
+
+    fn version(&self) -> anyhow::Result<String> {
+        package_version(D::NAME)
+    }
+
+    fn convention(&self) -> Tangential {
+        D::CONVENTION
+    }
+
+    /// The family computes its set-up forces without advancing the tangential history
+    /// (`update->setupflag`).
+    fn setup_advances_history(&self) -> bool {
+        false
+    }
+
+    /// The data file ([`data_file`]) `stem.lmp`.
+    fn write_state(
+        &self,
+        s: &Snapshot,
+        density: f64,
+        dir: &Path,
+        stem: &str,
+    ) -> anyhow::Result<String> {
+        let name = format!("{stem}.lmp");
+        atomic::write(&dir.join(&name), data_file(s, density).as_bytes())?;
+        Ok(name)
+    }
+
+    /// Walls moved rigidly by `fix move` (infinite mass); thermo only at the start and the
+    /// end.
+    fn input_script(
+        &self,
+        case: &Case,
+        data: &str,
+        steps: u64,
+        dump_every: Option<u64>,
+    ) -> anyhow::Result<String> {
+        let (vb, vt) = wall_speeds(case)?;
+        let dt = case.dt();
+        let (output, dump) = match dump_every {
+            None => ("no file output".to_string(), String::new()),
+            Some(every) => (
+                format!("a dump every {every} steps"),
+                dump_commands::<D>(every),
+            ),
+        };
+        Ok(format!(
+            "# {} input generated by verdem from case {:?}: {steps} steps, {output}.\n\
+         # Types: 1 free, 2 bottom wall, 3 top wall (moved rigidly by fix move: infinite mass).\n\
+{}\
+timestep        {dt:?}\n\
+velocity        bottom set {vb:?} 0 0 units box\n\
+velocity        top    set {vt:?} 0 0 units box\n\
+fix             wbot bottom move linear {vb:?} 0 0\n\
+fix             wtop top    move linear {vt:?} 0 0\n\
+{}",
+            title::<D>(),
+            case.name,
+            D::setup_and_law(case, data),
+            integrate_and_run(&dump, steps),
+        ))
+    }
+
+    /// The fixed spheres (types 2 and 3) are held still by `fix move`.
+    fn collision_script(&self, case: &Case, data: &str, steps: u64) -> String {
+        format!(
+            "# {} input generated by verdem from case {:?}: a two-sphere collision, {steps} steps.\n\
+         # Types: 1 free, 2 and 3 fixed spheres (held still by fix move: infinite mass).\n\
+{}\
+timestep        {dt:?}\n\
+fix             still1 bottom move linear 0 0 0\n\
+fix             still2 top    move linear 0 0 0\n\
+{}",
+            title::<D>(),
+            case.name,
+            D::setup_and_law(case, data),
+            integrate_and_run(&dump_commands::<D>(steps), steps),
+            dt = case.dt(),
+        )
+    }
+
+    fn run(&self, np: usize, dir: &Path, input: &str) -> anyhow::Result<f64> {
+        run(D::BINARY, D::NAME, np, dir, input)
+    }
+
+    fn command_line(&self, np: usize) -> String {
+        let script = format!("in.{}", D::BINARY);
+        format!("mpirun {}", mpirun_args(D::BINARY, np, &script).join(" "))
+    }
+
+    /// `dump.STEP.txt` in `dir`.
+    fn read_frame(&self, dir: &Path, step: u64) -> anyhow::Result<Frame> {
+        Ok(dump::read(&dir.join(format!("dump.{step}.txt")))?)
+    }
+
+    /// `contacts.STEP.txt` in `dir`: the contact forces are re-evaluated at the end of the
+    /// step, with full-step velocities in the dashpots where the step itself used half-step
+    /// velocities; the tangential springs are not dumped, so `xi` is zero.
+    fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
+        let path = dir.join(format!("contacts.{step}.txt"));
+        let x = &s.particles.x;
+        let mut out = Vec::new();
+        for r in dump::read_entries(&path, D::CONTACT_COLUMNS)? {
+            let (a, b) = (r[0] as usize, r[1] as usize);
+            ensure!(
+                (1..=x.len()).contains(&a) && (1..=x.len()).contains(&b),
+                "{}: atom ids {a} {b} out of range",
+                path.display()
+            );
+            let (a, b) = (a - 1, b - 1);
+            let on_a = D::force_on_first(&r, s, a, b);
+            if on_a == Vec3::zeros() {
+                continue;
+            }
+            let (p, i, f) = if a < b { (a, b, on_a) } else { (b, a, -on_a) };
+            let n = s.domain.min_image(x[p] - x[i]).normalize();
+            out.push(Contact {
+                p: p as u32,
+                i: i as u32,
+                history: Vec::new(),
+                spring: Vec3::zeros(),
+                force: PairForce {
+                    f,
+                    fn_signed: f.dot(&n),
+                    torque_p: Vec3::zeros(),
+                    torque_i: Vec3::zeros(),
+                },
+            });
+        }
+        out.sort_unstable_by_key(|c| (c.p, c.i));
+        Ok(out)
+    }
+}
