@@ -5,8 +5,6 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::neighbor::Search;
-
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
 #[error("{file}:{line}: {field}: {msg}")]
@@ -81,6 +79,16 @@ pub struct Neighbor {
     /// `cells` (default) or `all-pairs`.
     #[serde(default = "default_search")]
     pub search: Search,
+}
+
+/// How candidate pairs are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Search {
+    /// Cell grid of edge ≥ 2 r_max + skin (the default).
+    Cells,
+    /// Every pair is tested (O(N²); a reference for tests).
+    AllPairs,
 }
 
 fn default_skin() -> f64 {

@@ -7,18 +7,9 @@
 //! oriented by original ids (P = lower id), and each particle's list of pairs is sorted by its
 //! partners' original ids.
 
+use crate::case::Search;
 use crate::domain::Domain;
 use crate::Vec3;
-
-/// How candidate pairs are found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Search {
-    /// Cell grid of edge ≥ 2 r_max + skin (the default).
-    Cells,
-    /// Every pair is tested (O(N²); a reference for tests).
-    AllPairs,
-}
 
 /// The pair list, in memory indices. Pair `k` joins `p[k]` and `i[k]` with
 /// `id[p[k]] < id[i[k]]`; as built, pairs are grouped by their lower memory index (`owner`),

@@ -55,11 +55,6 @@ impl RunSummary {
     }
 }
 
-/// Path of save `k` of kind `ext` (`data` or `fstat`).
-pub fn save_path(dir: &Path, name: &str, ext: &str, k: u64) -> PathBuf {
-    dir.join(format!("{name}.{ext}.{k:04}"))
-}
-
 /// Path of the diagnostics table.
 pub fn diagnostics_path(dir: &Path, name: &str) -> PathBuf {
     dir.join(format!("{name}.diagnostics.csv"))
@@ -156,10 +151,10 @@ fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()
 fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
     let core = &engine.core().snapshot();
     let k = core.step / opts.save_every;
-    let data = save_path(&opts.out_dir, &opts.name, "data", k);
+    let data = mercury::save_path(&opts.out_dir, &opts.name, "data", k);
     atomic::write(&data, mercury::data_text(core).as_bytes())
         .with_context(|| format!("{}: cannot write", data.display()))?;
-    let fstat = save_path(&opts.out_dir, &opts.name, "fstat", k);
+    let fstat = mercury::save_path(&opts.out_dir, &opts.name, "fstat", k);
     atomic::write(&fstat, mercury::fstat_text(core).as_bytes())
         .with_context(|| format!("{}: cannot write", fstat.display()))?;
     atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())

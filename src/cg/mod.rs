@@ -126,7 +126,7 @@ impl Series {
     }
 
     fn path(&self, ext: &str, k: u64) -> PathBuf {
-        crate::run::save_path(&self.dir, &self.name, ext, k)
+        mercury::save_path(&self.dir, &self.name, ext, k)
     }
 }
 
