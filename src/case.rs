@@ -128,7 +128,7 @@ pub struct Material {
 }
 
 /// Tangential contact conventions.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tangential {
     /// MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring +

@@ -7,9 +7,11 @@ use std::sync::Arc;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
-use verdem::case::Case;
+use verdem::case::{Case, Tangential};
 use verdem::cg::{self, table::Table, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
+use verdem::kinematics::Increment;
+use verdem::peers::Peer;
 use verdem::run::{self, RunOptions};
 use verdem::{bench, checkpoint, hash, scene};
 
@@ -84,7 +86,7 @@ enum Command {
         to: Option<u64>,
         #[arg(long, default_value_t = 100, value_parser = count::<usize>)]
         slices: usize,
-        #[arg(long, value_enum, default_value_t = KernelChoice::Heaviside)]
+        #[arg(long, default_value = KernelChoice::Heaviside.name(), value_parser = named(&KernelChoice::ALL, KernelChoice::name))]
         kernel: KernelChoice,
         /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
         #[arg(long, allow_negative_numbers = true, value_parser = positive)]
@@ -138,8 +140,8 @@ enum Command {
         only: Option<String>,
         /// Also run the binary collisions in these installed peers (lammps, liggghts), against
         /// the same closed forms.
-        #[arg(long, value_enum, value_delimiter = ',')]
-        peers: Vec<verdem::peers::Peer>,
+        #[arg(long, value_delimiter = ',', value_parser = named(&Peer::ALL, Peer::name))]
+        peers: Vec<Peer>,
         /// Where the peers' collision runs go.
         #[arg(long, default_value = "out/verify")]
         out: PathBuf,
@@ -166,8 +168,8 @@ enum Command {
     /// series as MercuryCG saves and the table as OUT/cross.md.
     Cross {
         /// The peer: lammps (`lmp`) or liggghts (`liggghts`), run with mpirun.
-        #[arg(value_enum)]
-        peer: verdem::peers::Peer,
+        #[arg(value_parser = named(&Peer::ALL, Peer::name))]
+        peer: Peer,
         /// Case file (default: cases/shear_flow_quick.toml).
         #[arg(default_value = "cases/shear_flow_quick.toml")]
         case: PathBuf,
@@ -186,8 +188,8 @@ enum Command {
         out: PathBuf,
         /// Run verdem with this tangential convention instead of the peer's (to see what a
         /// convention changes).
-        #[arg(long, value_enum)]
-        convention: Option<verdem::case::Tangential>,
+        #[arg(long, value_parser = named(&Tangential::ALL, Tangential::name))]
+        convention: Option<Tangential>,
     },
     /// The speed/accuracy trade: the case under variants (dt, softer contacts, skin, threads)
     /// from the same state for the same simulated time; cost, restitution error and the
@@ -224,8 +226,8 @@ enum Command {
         out: PathBuf,
         /// Velocities of the increment over a step: from positions and quaternions (what
         /// verdem's integrator feeds its law) or the mean of the two rows' velocities.
-        #[arg(long, value_enum, default_value_t = verdem::kinematics::Increment::Positions)]
-        increment: verdem::kinematics::Increment,
+        #[arg(long, default_value = Increment::Positions.name(), value_parser = named(&Increment::ALL, Increment::name))]
+        increment: Increment,
     },
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash {
@@ -317,6 +319,16 @@ fn count<T: std::str::FromStr<Err = std::num::ParseIntError> + PartialOrd + From
     } else {
         Err(format!("must be 1 or more, got {s}"))
     }
+}
+
+/// A value named by `name`, one of `all`; `--help` and the error for any other name list the names.
+fn named<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(all.iter().map(|&v| name(v)))
+        .map(move |s| *all.iter().find(|&&v| name(v) == s).expect("a listed name"))
 }
 
 /// A length or time that must be positive and finite.

@@ -71,11 +71,29 @@ impl CgOptions {
 }
 
 /// Kernel families.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelChoice {
     Heaviside,
     Gauss,
     Lucy,
+}
+
+impl KernelChoice {
+    /// Every family.
+    pub const ALL: [KernelChoice; 3] = [
+        KernelChoice::Heaviside,
+        KernelChoice::Gauss,
+        KernelChoice::Lucy,
+    ];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelChoice::Heaviside => "heaviside",
+            KernelChoice::Gauss => "gauss",
+            KernelChoice::Lucy => "lucy",
+        }
+    }
 }
 
 /// A series of saves on disk.

@@ -24,13 +24,24 @@ use crate::sim::Snapshot;
 use crate::state::Motion;
 
 /// A peer code.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Peer {
     Lammps,
     Liggghts,
 }
 
 impl Peer {
+    /// Every peer.
+    pub const ALL: [Peer; 2] = [Peer::Lammps, Peer::Liggghts];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Peer::Lammps => "lammps",
+            Peer::Liggghts => "liggghts",
+        }
+    }
+
     /// Name of the installed binary.
     pub fn binary(self) -> &'static str {
         match self {
