@@ -84,9 +84,9 @@ enum Command {
         /// Last save (default: the last).
         #[arg(long)]
         to: Option<u64>,
-        #[arg(long, default_value_t = 100, value_parser = count::<usize>)]
+        #[arg(long, default_value_t = CgOptions::default().slices, value_parser = count::<usize>)]
         slices: usize,
-        #[arg(long, default_value = KernelChoice::Heaviside.name(), value_parser = named(&KernelChoice::ALL, KernelChoice::name))]
+        #[arg(long, default_value = CgOptions::default().kernel.name(), value_parser = named(&KernelChoice::ALL, KernelChoice::name))]
         kernel: KernelChoice,
         /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
         #[arg(long, allow_negative_numbers = true, value_parser = positive)]
@@ -96,7 +96,7 @@ enum Command {
         #[arg(long)]
         case: Option<PathBuf>,
         /// Blocks of saves for the standard errors.
-        #[arg(long, default_value_t = 10, value_parser = count::<usize>)]
+        #[arg(long, default_value_t = CgOptions::default().blocks, value_parser = count::<usize>)]
         blocks: usize,
     },
     /// Time verdem against the installed LAMMPS and LIGGGHTS on the same case and state.
@@ -516,17 +516,7 @@ fn real_main() -> anyhow::Result<Finished> {
         } => {
             let mut o = match case {
                 Some(c) => CgOptions::for_case(&Case::load(&c)?),
-                None => CgOptions {
-                    from: None,
-                    to: None,
-                    slices: 100,
-                    kernel: KernelChoice::Heaviside,
-                    width: None,
-                    walls: 480,
-                    density: 1.0,
-                    periodic: [true, true, false],
-                    blocks: 10,
-                },
+                None => CgOptions::default(),
             };
             o.from = from;
             o.to = to;

@@ -42,9 +42,27 @@ pub struct CgOptions {
     pub blocks: usize,
 }
 
+/// The benchmark's saves: ids 1-480 walls, density 1, periodic in x and y; 100 slices,
+/// Heaviside kernel of the slice height, 10 blocks, the second half of the series.
+impl Default for CgOptions {
+    fn default() -> Self {
+        CgOptions {
+            from: None,
+            to: None,
+            slices: 100,
+            kernel: KernelChoice::Heaviside,
+            width: None,
+            walls: 480,
+            density: 1.0,
+            periodic: [true, true, false],
+            blocks: 10,
+        }
+    }
+}
+
 impl CgOptions {
-    /// The defaults for a case's saves: its wall spheres, density and periodicity; 100 slices,
-    /// Heaviside kernel, 10 blocks, the second half of the series.
+    /// The defaults for a case's saves: its wall spheres, density and periodicity; the rest as
+    /// [`CgOptions::default`].
     pub fn for_case(case: &crate::case::Case) -> CgOptions {
         use crate::case::Scene;
         let walls = match &case.scene {
@@ -57,15 +75,10 @@ impl CgOptions {
             Scene::Gas { .. } => 0,
         };
         CgOptions {
-            from: None,
-            to: None,
-            slices: 100,
-            kernel: KernelChoice::Heaviside,
-            width: None,
             walls,
             density: case.material.density,
             periodic: case.domain.periodic,
-            blocks: 10,
+            ..CgOptions::default()
         }
     }
 }
