@@ -173,6 +173,19 @@ impl Tangential {
             Tangential::Objective => "objective",
         }
     }
+
+    /// One line saying what the convention does and whose it is (for help texts).
+    pub fn description(self) -> &'static str {
+        match self {
+            Tangential::Mercury => "MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring + dashpot",
+            Tangential::LammpsHookeHistory => "LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms",
+            Tangential::LammpsGranular => "LAMMPS `granular … tangential linear_history`: project and rescale, then increment",
+            Tangential::Liggghts => "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding",
+            Tangential::Yade => "Yade's first-order rotation of the spring with the objective slip",
+            Tangential::Cundall => "Cundall & Strack 1979: no frame update at all",
+            Tangential::Objective => "The objective reference law: exact rotation with the contact frame, objective slip",
+        }
+    }
 }
 
 /// `[contact]`: the contact law.

@@ -72,6 +72,14 @@ impl Increment {
             Increment::Trapezoid => "trapezoid",
         }
     }
+
+    /// One line saying which velocities it takes (for help texts).
+    pub fn description(self) -> &'static str {
+        match self {
+            Increment::Positions => "From positions and quaternions (the step-average velocities)",
+            Increment::Trapezoid => "The mean of the two rows' velocities",
+        }
+    }
 }
 
 /// A contact law behind a pointer (the driver needs no static dispatch).

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use verdem::case::{Case, Tangential};
 use verdem::peers::{cross, Peer};
 
-use super::args::{count, named};
+use super::args::{count, described, named};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -32,7 +32,10 @@ pub struct Args {
     out: PathBuf,
     /// Run verdem with this tangential convention instead of the peer's (to see what a
     /// convention changes).
-    #[arg(long, value_parser = named(&Tangential::ALL, Tangential::name))]
+    #[arg(
+        long,
+        value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
+    )]
     convention: Option<Tangential>,
 }
 

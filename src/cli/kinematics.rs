@@ -7,7 +7,7 @@ use verdem::case::Case;
 use verdem::io::{self, atomic};
 use verdem::kinematics::{self, Increment};
 
-use super::args::named;
+use super::args::described;
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(
         long,
         default_value = Increment::Positions.name(),
-        value_parser = named(&Increment::ALL, Increment::name)
+        value_parser = described(&Increment::ALL, Increment::name, Increment::description)
     )]
     increment: Increment,
 }
