@@ -428,6 +428,30 @@ fn csv_field(v: &str) -> String {
     }
 }
 
+/// The first lines of `bench.md`: what was timed (`steps` steps of `case` from the state file
+/// `from`, `rounds` alternating rounds) and on what (the CPUs this process may use and
+/// [`cpu_model`]).
+pub fn header(case: &str, from: &Path, steps: u64, rounds: usize) -> String {
+    format!(
+        "{steps} steps of {case} from {}, {rounds} alternating rounds, {} cores ({}), no file output in the timed region\n\n",
+        from.display(),
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0),
+        cpu_model()
+    )
+}
+
+/// The CPU's model name from `/proc/cpuinfo` (empty where there is none, e.g. off Linux).
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|c| {
+            c.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_default()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

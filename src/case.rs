@@ -5,8 +5,6 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::neighbor::Search;
-
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
 #[error("{file}:{line}: {field}: {msg}")]
@@ -83,6 +81,16 @@ pub struct Neighbor {
     pub search: Search,
 }
 
+/// How candidate pairs are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Search {
+    /// Cell grid of edge ≥ 2 r_max + skin (the default).
+    Cells,
+    /// Every pair is tested (O(N²); a reference for tests).
+    AllPairs,
+}
+
 fn default_skin() -> f64 {
     0.1
 }
@@ -120,7 +128,7 @@ pub struct Material {
 }
 
 /// Tangential contact conventions.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tangential {
     /// MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring +
@@ -163,6 +171,19 @@ impl Tangential {
             Tangential::Yade => "yade",
             Tangential::Cundall => "cundall",
             Tangential::Objective => "objective",
+        }
+    }
+
+    /// One line saying what the convention does and whose it is (for help texts).
+    pub fn description(self) -> &'static str {
+        match self {
+            Tangential::Mercury => "MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring + dashpot",
+            Tangential::LammpsHookeHistory => "LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms",
+            Tangential::LammpsGranular => "LAMMPS `granular … tangential linear_history`: project and rescale, then increment",
+            Tangential::Liggghts => "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding",
+            Tangential::Yade => "Yade's first-order rotation of the spring with the objective slip",
+            Tangential::Cundall => "Cundall & Strack 1979: no frame update at all",
+            Tangential::Objective => "The objective reference law: exact rotation with the contact frame, objective slip",
         }
     }
 }

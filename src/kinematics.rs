@@ -53,12 +53,33 @@ pub struct ForceRow {
 }
 
 /// Which velocities drive the increment of a step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Increment {
     /// From positions and quaternions (the step-average velocities).
     Positions,
     /// The mean of the two rows' velocities.
     Trapezoid,
+}
+
+impl Increment {
+    /// Every choice.
+    pub const ALL: [Increment; 2] = [Increment::Positions, Increment::Trapezoid];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Increment::Positions => "positions",
+            Increment::Trapezoid => "trapezoid",
+        }
+    }
+
+    /// One line saying which velocities it takes (for help texts).
+    pub fn description(self) -> &'static str {
+        match self {
+            Increment::Positions => "From positions and quaternions (the step-average velocities)",
+            Increment::Trapezoid => "The mean of the two rows' velocities",
+        }
+    }
 }
 
 /// A contact law behind a pointer (the driver needs no static dispatch).

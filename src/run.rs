@@ -48,21 +48,53 @@ pub struct RunSummary {
     pub interrupted: bool,
 }
 
+/// Steps of the full bumpy-shear benchmark (`cases/shear_flow.toml`, `docs/benchmark.md`: Nt).
+pub const BENCHMARK_STEPS: u64 = 200_000_000;
+
 impl RunSummary {
     /// Steps per second of this invocation.
     pub fn rate(&self) -> f64 {
         self.steps_run as f64 / self.seconds.max(1e-12)
     }
-}
 
-/// Path of save `k` of kind `ext` (`data` or `fstat`).
-pub fn save_path(dir: &Path, name: &str, ext: &str, k: u64) -> PathBuf {
-    dir.join(format!("{name}.{ext}.{k:04}"))
+    /// Wall time (hours) `steps` steps would take at this invocation's [`rate`](Self::rate).
+    pub fn hours_for(&self, steps: u64) -> f64 {
+        steps as f64 / self.rate() / 3600.0
+    }
+
+    /// The summary file's text (TOML): the case's name, the final step, time and state hash,
+    /// the run's `threads` and its rate (steps per second).
+    pub fn toml(&self, case: &str, threads: usize) -> String {
+        format!(
+            "case = {case:?}\nstep = {}\ntime = {}\nhash = {:?}\nthreads = {threads}\nsteps_per_second = {}\n",
+            self.step,
+            self.time,
+            self.hash,
+            self.rate()
+        )
+    }
 }
 
 /// Path of the diagnostics table.
 pub fn diagnostics_path(dir: &Path, name: &str) -> PathBuf {
     dir.join(format!("{name}.diagnostics.csv"))
+}
+
+/// Path of the run summary ([`RunSummary::toml`]).
+pub fn summary_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.summary.toml"))
+}
+
+/// Writes the summary of the run `name` on `threads` threads into `dir` (atomically).
+pub fn write_summary(
+    dir: &Path,
+    name: &str,
+    summary: &RunSummary,
+    threads: usize,
+) -> anyhow::Result<()> {
+    let p = summary_path(dir, name);
+    atomic::write(&p, summary.toml(name, threads).as_bytes())
+        .with_context(|| p.display().to_string())
 }
 
 /// Path of the run's checkpoint.
@@ -155,10 +187,10 @@ fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()
 fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
     let core = &engine.snapshot();
     let k = core.step / opts.save_every;
-    let data = save_path(&opts.out_dir, &opts.name, "data", k);
+    let data = mercury::save_path(&opts.out_dir, &opts.name, "data", k);
     atomic::write(&data, mercury::data_text(core).as_bytes())
         .with_context(|| format!("{}: cannot write", data.display()))?;
-    let fstat = save_path(&opts.out_dir, &opts.name, "fstat", k);
+    let fstat = mercury::save_path(&opts.out_dir, &opts.name, "fstat", k);
     atomic::write(&fstat, mercury::fstat_text(core).as_bytes())
         .with_context(|| format!("{}: cannot write", fstat.display()))?;
     atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())

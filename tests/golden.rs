@@ -6,6 +6,7 @@ mod common;
 
 use common::*;
 use verdem::engine::Overrides;
+use verdem::io::mercury;
 use verdem::run;
 
 fn golden(name: &str, how: &str, body: String) {
@@ -40,7 +41,7 @@ fn short_run(
         let s = run_with_saves(e.as_mut(), dir.path(), "g", steps, save_every);
         let last = steps / save_every;
         let head = |ext: &str, n: usize| -> String {
-            std::fs::read_to_string(run::save_path(dir.path(), "g", ext, last))
+            std::fs::read_to_string(mercury::save_path(dir.path(), "g", ext, last))
                 .unwrap()
                 .lines()
                 .take(n)

@@ -64,7 +64,7 @@ fn two_spheres() -> Simulation<AgingLaw> {
         let (x, v) = (Vec3::new(0.0, 0.0, z), Vec3::new(0.0, 0.0, v));
         p.push(x, v, Vec3::zeros(), 0.5, 1.0, Motion::Free);
     }
-    let builder = NeighborBuilder::new(0.1, 0.0, 0.5, verdem::neighbor::Search::AllPairs);
+    let builder = NeighborBuilder::new(0.1, 0.0, 0.5, verdem::case::Search::AllPairs);
     let core = Core::new(domain, p, 1e-3, None, builder, 1);
     Simulation::new(
         AgingLaw {

@@ -51,8 +51,8 @@ fn resumed_run_matches_uninterrupted_run_bit_for_bit() {
     assert_eq!(resumed.hash, reference.hash);
     for k in 0..=3 {
         for ext in ["data", "fstat"] {
-            let a = std::fs::read(run::save_path(full_dir.path(), "q", ext, k)).unwrap();
-            let b = std::fs::read(run::save_path(dir.path(), "q", ext, k)).unwrap();
+            let a = std::fs::read(mercury::save_path(full_dir.path(), "q", ext, k)).unwrap();
+            let b = std::fs::read(mercury::save_path(dir.path(), "q", ext, k)).unwrap();
             assert!(a == b, "save {k} .{ext} differs");
         }
     }
@@ -108,7 +108,7 @@ fn saves_round_trip_and_follow_mercurydpm_conventions() {
     );
     run::run(e.as_mut(), &options(dir.path(), 1000, 0), false).unwrap();
     let snap = e.snapshot();
-    let data = mercury::read_data(&run::save_path(dir.path(), "q", "data", 1)).unwrap();
+    let data = mercury::read_data(&mercury::save_path(dir.path(), "q", "data", 1)).unwrap();
     assert_eq!(data.time.to_bits(), snap.time.to_bits());
     assert_eq!(data.rows.len(), 3480);
     for (a, row) in data.rows.iter().enumerate() {
@@ -116,7 +116,7 @@ fn saves_round_trip_and_follow_mercurydpm_conventions() {
         assert_eq!(row.v, snap.particles.v[a]);
         assert_eq!(row.w, snap.particles.w[a]);
     }
-    let fstat = mercury::read_fstat(&run::save_path(dir.path(), "q", "fstat", 1)).unwrap();
+    let fstat = mercury::read_fstat(&mercury::save_path(dir.path(), "q", "fstat", 1)).unwrap();
     let free = |k: usize| k >= 480;
     let expected: usize = snap
         .contacts

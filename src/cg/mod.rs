@@ -42,9 +42,27 @@ pub struct CgOptions {
     pub blocks: usize,
 }
 
+/// The benchmark's saves: ids 1-480 walls, density 1, periodic in x and y; 100 slices,
+/// Heaviside kernel of the slice height, 10 blocks, the second half of the series.
+impl Default for CgOptions {
+    fn default() -> Self {
+        CgOptions {
+            from: None,
+            to: None,
+            slices: 100,
+            kernel: KernelChoice::Heaviside,
+            width: None,
+            walls: 480,
+            density: 1.0,
+            periodic: [true, true, false],
+            blocks: 10,
+        }
+    }
+}
+
 impl CgOptions {
-    /// The defaults for a case's saves: its wall spheres, density and periodicity; 100 slices,
-    /// Heaviside kernel, 10 blocks, the second half of the series.
+    /// The defaults for a case's saves: its wall spheres, density and periodicity; the rest as
+    /// [`CgOptions::default`].
     pub fn for_case(case: &crate::case::Case) -> CgOptions {
         use crate::case::Scene;
         let walls = match &case.scene {
@@ -57,25 +75,38 @@ impl CgOptions {
             Scene::Gas { .. } => 0,
         };
         CgOptions {
-            from: None,
-            to: None,
-            slices: 100,
-            kernel: KernelChoice::Heaviside,
-            width: None,
             walls,
             density: case.material.density,
             periodic: case.domain.periodic,
-            blocks: 10,
+            ..CgOptions::default()
         }
     }
 }
 
 /// Kernel families.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KernelChoice {
     Heaviside,
     Gauss,
     Lucy,
+}
+
+impl KernelChoice {
+    /// Every family.
+    pub const ALL: [KernelChoice; 3] = [
+        KernelChoice::Heaviside,
+        KernelChoice::Gauss,
+        KernelChoice::Lucy,
+    ];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelChoice::Heaviside => "heaviside",
+            KernelChoice::Gauss => "gauss",
+            KernelChoice::Lucy => "lucy",
+        }
+    }
 }
 
 /// A series of saves on disk.
@@ -126,7 +157,7 @@ impl Series {
     }
 
     fn path(&self, ext: &str, k: u64) -> PathBuf {
-        crate::run::save_path(&self.dir, &self.name, ext, k)
+        mercury::save_path(&self.dir, &self.name, ext, k)
     }
 }
 

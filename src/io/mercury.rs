@@ -12,7 +12,7 @@
 //! contact is written twice (i j, then j i with n and t negated), a free–wall contact once, free
 //! particle first.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::{fmt_f64, parse_numbers, FormatError};
 use crate::contact::PairInput;
@@ -20,6 +20,12 @@ use crate::state::Domain;
 use crate::state::Motion;
 use crate::state::Snapshot;
 use crate::Vec3;
+
+/// Path of save `k` of kind `ext` (`data` or `fstat`) of the series `dir/name`:
+/// `dir/name.ext.NNNN`, `k` zero-padded to four digits (MercuryCG's numbering).
+pub fn save_path(dir: &Path, name: &str, ext: &str, k: u64) -> PathBuf {
+    dir.join(format!("{name}.{ext}.{k:04}"))
+}
 
 fn push_vec(s: &mut String, v: &Vec3) {
     for k in 0..3 {

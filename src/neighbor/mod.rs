@@ -9,18 +9,9 @@
 
 pub mod rebuild;
 
+use crate::case::Search;
 use crate::state::Domain;
 use crate::Vec3;
-
-/// How candidate pairs are found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Search {
-    /// Cell grid of edge ≥ 2 r_max + skin (the default).
-    Cells,
-    /// Every pair is tested (O(N²); a reference for tests).
-    AllPairs,
-}
 
 /// The pair list, in memory indices. Pair `k` joins `p[k]` and `i[k]` with
 /// `id[p[k]] < id[i[k]]`; as built, pairs are grouped by their lower memory index (`owner`),

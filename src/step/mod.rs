@@ -457,7 +457,7 @@ mod tests {
         scene: Scene,
         dt: f64,
         skin: f64,
-        search: crate::neighbor::Search,
+        search: crate::case::Search,
         steps: u64,
     }
 

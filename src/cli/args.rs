@@ -1,0 +1,116 @@
+//! Arguments and value parsers shared by several commands.
+
+use std::path::PathBuf;
+
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+
+use verdem::case::Case;
+use verdem::engine::{self, Overrides};
+use verdem::scene;
+use verdem::step::Engine;
+
+/// The case and how to run it (`run`, `hash`).
+#[derive(clap::Args, Clone)]
+pub struct Common {
+    /// Case file (TOML).
+    case: PathBuf,
+    /// Initial configuration: official `GranularShearFlow.data` or a MercuryCG `.data` save.
+    #[arg(long)]
+    init: Option<PathBuf>,
+    /// Worker threads of the time step.
+    #[arg(long, value_parser = count::<usize>)]
+    threads: Option<usize>,
+    /// Leave the threads to the scheduler: by default thread t of a team of two or more runs on
+    /// the t-th CPU the process may use (start two multi-threaded runs side by side with
+    /// `taskset -c` on disjoint CPUs).
+    #[arg(long)]
+    no_bind: bool,
+    /// Pair-list skin (length).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
+    skin: Option<f64>,
+    /// Cell edge of the neighbour grid (length; raised to 2 r_max + skin).
+    #[arg(long, allow_negative_numbers = true, value_parser = non_negative)]
+    cell: Option<f64>,
+}
+
+impl Common {
+    /// The case and its engine, built with the command line's overrides; warns when the team
+    /// has more threads than the process may use CPUs.
+    pub fn load(&self) -> anyhow::Result<(Case, Box<dyn Engine>)> {
+        let case = Case::load(&self.case)?;
+        let scene = scene::build(&case, self.init.as_deref())?;
+        let o = Overrides {
+            threads: self.threads,
+            bind: self.no_bind.then_some(false),
+            skin: self.skin,
+            cell: self.cell,
+        };
+        let engine = engine::build(&case, scene, &o);
+        if let Some(warning) = verdem::team::oversubscribed(engine.params().threads) {
+            eprintln!("warning: {warning}");
+        }
+        Ok((case, engine))
+    }
+}
+
+/// A count of one or more (threads, ranks, rounds, slices, blocks, steps between saves).
+pub fn count<T: std::str::FromStr<Err = std::num::ParseIntError> + PartialOrd + From<u8>>(
+    s: &str,
+) -> Result<T, String> {
+    let v: T = s.parse().map_err(|e| format!("{e}"))?;
+    if v >= T::from(1) {
+        Ok(v)
+    } else {
+        Err(format!("must be 1 or more, got {s}"))
+    }
+}
+
+/// A length or time that must be positive and finite.
+pub fn positive(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be positive and finite, got {s}"))
+    }
+}
+
+/// A length that must be zero or positive, and finite.
+pub fn non_negative(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be zero or positive and finite, got {s}"))
+    }
+}
+
+/// A value named by `name`, one of `all`; `--help` and the error for any other name list the
+/// names.
+pub fn named<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+) -> impl TypedValueParser<Value = T> {
+    one_of(all, name, |_| None)
+}
+
+/// As [`named`], and `--help` gives each value's `description`.
+pub fn described<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+    description: fn(T) -> &'static str,
+) -> impl TypedValueParser<Value = T> {
+    one_of(all, name, move |v| Some(description(v)))
+}
+
+fn one_of<T: Copy + Send + Sync + 'static>(
+    all: &'static [T],
+    name: fn(T) -> &'static str,
+    help: impl Fn(T) -> Option<&'static str>,
+) -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(
+        all.iter()
+            .map(|&v| PossibleValue::new(name(v)).help(help(v))),
+    )
+    .map(move |s| *all.iter().find(|&&v| name(v) == s).expect("a listed name"))
+}

@@ -1,0 +1,59 @@
+//! `verdem cg`: coarse-grain a MercuryCG series into z-profiles with error bars, checks and a
+//! plot.
+
+use std::path::PathBuf;
+
+use verdem::case::Case;
+use verdem::cg::{self, CgOptions, KernelChoice};
+
+use super::args::{count, named, positive};
+use super::Finished;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Series base name: DIR/NAME for DIR/NAME.data.NNNN and DIR/NAME.fstat.NNNN.
+    base: PathBuf,
+    /// First save (default: the second half of the series).
+    #[arg(long)]
+    from: Option<u64>,
+    /// Last save (default: the last).
+    #[arg(long)]
+    to: Option<u64>,
+    #[arg(long, default_value_t = CgOptions::default().slices, value_parser = count::<usize>)]
+    slices: usize,
+    #[arg(
+        long,
+        default_value = CgOptions::default().kernel.name(),
+        value_parser = named(&KernelChoice::ALL, KernelChoice::name)
+    )]
+    kernel: KernelChoice,
+    /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
+    width: Option<f64>,
+    /// Case file telling which particles are walls and the density (default: the
+    /// benchmark's, ids 1-480 walls, density 1).
+    #[arg(long)]
+    case: Option<PathBuf>,
+    /// Blocks of saves for the standard errors.
+    #[arg(long, default_value_t = CgOptions::default().blocks, value_parser = count::<usize>)]
+    blocks: usize,
+}
+
+pub fn exec(a: Args) -> anyhow::Result<Finished> {
+    let saves = match a.case {
+        Some(c) => CgOptions::for_case(&Case::load(&c)?),
+        None => CgOptions::default(),
+    };
+    let o = CgOptions {
+        from: a.from,
+        to: a.to,
+        slices: a.slices,
+        kernel: a.kernel,
+        width: a.width,
+        blocks: a.blocks,
+        ..saves
+    };
+    let (_, report) = cg::write_all(&a.base, &o)?;
+    print!("{report}");
+    Ok(Finished::Done)
+}

@@ -1,0 +1,52 @@
+//! `verdem cross`: run a peer and verdem on the same case and state and compare them save by
+//! save.
+
+use std::path::PathBuf;
+
+use verdem::case::{Case, Tangential};
+use verdem::peers::{cross, Peer};
+
+use super::args::{count, described};
+use super::Finished;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The peer, by name (`verdem peers` lists them: lammps, liggghts).
+    #[arg(value_parser = verdem::peers::by_name)]
+    peer: &'static dyn Peer,
+    /// Case file (default: cases/shear_flow_quick.toml).
+    #[arg(default_value = "cases/shear_flow_quick.toml")]
+    case: PathBuf,
+    /// State to start from.
+    #[arg(long, default_value = "data/states/mercury_t143.85.data")]
+    from: PathBuf,
+    #[arg(long, default_value_t = 20000, value_parser = count::<u64>)]
+    steps: u64,
+    /// A save every N steps.
+    #[arg(long, default_value_t = 2000, value_parser = count::<u64>)]
+    every: u64,
+    /// MPI ranks of the peer (and verdem's threads).
+    #[arg(long, default_value_t = 2, value_parser = count::<usize>)]
+    np: usize,
+    #[arg(long, default_value = "out/cross")]
+    out: PathBuf,
+    /// Run verdem with this tangential convention instead of the peer's (to see what a
+    /// convention changes).
+    #[arg(
+        long,
+        value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
+    )]
+    convention: Option<Tangential>,
+}
+
+pub fn exec(a: Args) -> anyhow::Result<Finished> {
+    let case = Case::load(&a.case)?;
+    let out = a.out.join(a.peer.binary());
+    let convention = a.convention.unwrap_or(a.peer.convention());
+    let report = cross::cross(
+        a.peer, &case, convention, &a.from, a.steps, a.every, a.np, &out,
+    )?;
+    print!("{}", report.markdown());
+    println!("(saves and tables in {})", out.display());
+    Ok(Finished::Done)
+}

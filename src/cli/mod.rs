@@ -1,0 +1,27 @@
+//! The commands' glue: each command's arguments (clap types live only here) and the calls into
+//! the library that carry it out, one file per command; [`args`] holds what several share.
+
+pub mod args;
+pub mod bench;
+pub mod cg;
+pub mod compare;
+pub mod cross;
+pub mod hash;
+pub mod kinematics;
+pub mod peers;
+pub mod run;
+pub mod tradeoff;
+pub mod verify;
+
+/// Exit status of a run stopped by a signal after writing its checkpoint (128 + SIGINT, as a
+/// shell reports a process that SIGINT ended).
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// How a command ended, when it did not fail.
+pub enum Finished {
+    Done,
+    /// A run stopped by a signal, its checkpoint written.
+    Interrupted,
+    /// Checks failed; the command has reported which (exit status 1).
+    ChecksFailed,
+}

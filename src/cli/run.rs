@@ -1,0 +1,209 @@
+//! `verdem run`: run a case, report its rate and stages, write its summary and, for the
+//! bumpy-shear scene, coarse-grain its saves.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::Context;
+
+use verdem::case::{Case, Scene};
+use verdem::cg::{self, CgOptions};
+use verdem::io::checkpoint;
+use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
+
+use super::args::{count, Common};
+use super::{Finished, EXIT_INTERRUPTED};
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    common: Common,
+    /// The run ends at this step (default: the case's `run.steps`), also after --resume.
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Output folder (default: out/NAME).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// A save every N steps (default: the case's `run.save_every`).
+    #[arg(long, value_parser = count::<u64>)]
+    save_every: Option<u64>,
+    /// Write a checkpoint every N steps (0 = never).
+    #[arg(long, default_value_t = 0)]
+    checkpoint_every: u64,
+    /// Continue from a checkpoint written by --checkpoint-every.
+    #[arg(long)]
+    resume: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+pub fn exec(a: Args) -> anyhow::Result<Finished> {
+    let (case, mut engine) = a.common.load()?;
+    print_contact_summary(&case);
+    let tag = format!("{}:{}", case.name, engine.state().particles.len());
+    if let Some(ck) = &a.resume {
+        checkpoint::read(ck, engine.as_mut(), &tag)?;
+        println!(
+            "resumed at step {} (t = {})",
+            engine.state().step,
+            engine.state().time
+        );
+    }
+    let end_step = a.steps.unwrap_or(case.run.steps);
+    if end_step < engine.state().step {
+        anyhow::bail!(
+            "the run would end at step {end_step} ({}), before the checkpoint's step {}",
+            if a.steps.is_some() {
+                "--steps"
+            } else {
+                "the case's run.steps"
+            },
+            engine.state().step
+        );
+    }
+    let opts = RunOptions {
+        end_step,
+        save_every: a.save_every.unwrap_or(case.run.save_every),
+        checkpoint_every: a.checkpoint_every,
+        out_dir: a
+            .out
+            .unwrap_or_else(|| PathBuf::from("out").join(&case.name)),
+        name: case.name.clone(),
+        tag,
+        progress: !a.quiet,
+        write_saves: true,
+        stop: Some(stop_on_signal()?),
+    };
+    let s = run::run(engine.as_mut(), &opts, a.resume.is_some())?;
+    if s.interrupted {
+        let ck = run::checkpoint_path(&opts.out_dir, &opts.name);
+        println!(
+            "interrupted at step {} (t = {}) after {} saves; checkpoint {}",
+            s.step,
+            s.time,
+            s.saves,
+            ck.display()
+        );
+        println!("continue with: {}", resume_command(&ck));
+        return Ok(Finished::Interrupted);
+    }
+    println!(
+        "done: step {} t = {} saves {} in {}",
+        s.step,
+        s.time,
+        s.saves,
+        opts.out_dir.display()
+    );
+    let shear = matches!(case.scene, Scene::BumpyShear { .. });
+    let threads = engine.params().threads;
+    if s.steps_run > 0 {
+        let projection = if shear {
+            format!(
+                "; the full 2e8-step benchmark would take {:.2} h at this rate",
+                s.hours_for(BENCHMARK_STEPS)
+            )
+        } else {
+            String::new()
+        };
+        println!(
+            "rate: {:.0} steps/s on {threads} thread(s) ({:.1} s){projection}",
+            s.rate(),
+            s.seconds,
+        );
+    } else {
+        println!("rate: no steps run");
+    }
+    let st = &s.stages;
+    let ms = |ns: u64| ns as f64 * 1e-6;
+    println!(
+        "stages (thread 0): neighbour {:.0} ms ({} rebuilds), forces {:.0} ms, gather+integrate {:.0} ms, barrier wait {:.0} ms; {} pairs in the list",
+        ms(st.neighbor),
+        st.rebuilds,
+        ms(st.forces),
+        ms(st.integrate),
+        ms(st.wait),
+        engine.pair_count()
+    );
+    println!("state hash: {}", s.hash);
+    run::write_summary(&opts.out_dir, &case.name, &s, threads)?;
+    if s.saves > 0 && shear {
+        let (_, report) =
+            cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
+        println!(
+            "profiles: {}",
+            opts.out_dir
+                .join(format!("{}.profiles.csv", case.name))
+                .display()
+        );
+        print!("{report}");
+    } else if s.saves > 0 {
+        println!(
+            "profiles: none (the z-profiles and their checks describe the bumpy-shear \
+             scene; `verdem cg` coarse-grains these saves all the same)"
+        );
+    }
+    Ok(Finished::Done)
+}
+
+/// Prints the derived contact numbers so a user sees at once whether a contact is resolved.
+fn print_contact_summary(case: &Case) {
+    let m = case.particle_mass();
+    let dt = case.dt();
+    for (label, meff) in [("free-free", 0.5 * m), ("free-wall", m)] {
+        if let (Some(tc), Some(e)) = (case.collision_time(meff), case.restitution(meff)) {
+            println!("{label}: tc = {tc:.6e}, e = {e:.5}, tc/dt = {:.2}", tc / dt);
+        }
+    }
+    println!("dt = {dt:e}");
+}
+
+/// A flag raised by SIGINT, SIGTERM or SIGHUP (ctrlc's `termination` feature): a run then stops
+/// at the end of its block of steps and writes a checkpoint. A second signal ends the process at
+/// once; every file it has written is whole (written atomically) all the same.
+fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(EXIT_INTERRUPTED);
+        }
+        eprintln!(
+            "\nstopping: writing a checkpoint at the end of the steps under way \
+             (a second signal stops at once, without it)"
+        );
+    })
+    .context("cannot install the signal handler")?;
+    Ok(stop)
+}
+
+/// This process's command line with `--resume CHECKPOINT` in place of any `--resume` it had,
+/// quoted for a POSIX shell.
+fn resume_command(checkpoint: &Path) -> String {
+    let mut args: Vec<String> = Vec::new();
+    let mut skip = false;
+    for a in std::env::args() {
+        if std::mem::take(&mut skip) {
+            continue;
+        }
+        if a == "--resume" {
+            skip = true;
+        } else if !a.starts_with("--resume=") {
+            args.push(a);
+        }
+    }
+    args.push("--resume".into());
+    args.push(checkpoint.display().to_string());
+    let quote = |a: &String| {
+        let plain = a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+".contains(c));
+        if plain && !a.is_empty() {
+            a.clone()
+        } else {
+            format!("'{}'", a.replace('\'', r"'\''"))
+        }
+    };
+    args.iter().map(quote).collect::<Vec<_>>().join(" ")
+}
