@@ -8,16 +8,16 @@
 //! positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on P
 //! (I receives the opposite).
 
-pub mod conventions;
 pub mod normal;
 pub mod tangential;
 
 use crate::Vec3;
-pub use conventions::{
-    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, Objective, YadeApprox,
-};
 pub use normal::{LinearSpringDashpot, NormalModel};
-pub use tangential::{Frictionless, MercurySlidingFriction, TangentialModel};
+pub use tangential::conventions::{
+    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
+    YadeApprox,
+};
+pub use tangential::{Frictionless, TangentialModel};
 
 /// Kinematics of one pair in contact, evaluated at the contact point.
 #[derive(Clone, Copy, Debug)]

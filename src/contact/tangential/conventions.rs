@@ -1,34 +1,14 @@
-//! Tangential models: elastic spring ξ stored per contact, dashpot and Coulomb cap.
-//! The returned vector is the tangential force on P.
+//! The named tangential conventions: MercuryDPM's sliding friction, the conventions of peer
+//! codes and the objective reference law.
 
-use super::PairKinematics;
+use super::cap::{LammpsCap, LiggghtsCap, SpringThenTotal};
+use super::frame::{
+    ExactRotation, FirstOrderRotation, NoFrameUpdate, ProjectAfter, ProjectRescale,
+};
+use super::slip::{FullRadiusSlip, HalfOverlapSlip, MidpointObjectiveSlip, ObjectiveSlip};
+use super::{Convention, TangentialModel};
+use crate::contact::PairKinematics;
 use crate::Vec3;
-
-/// A tangential model. `fn_signed` is the signed normal force of the same contact; `xi` is the
-/// contact's elastic tangential displacement (length), updated in place over the step `dt`.
-pub trait TangentialModel: Send + Sync {
-    /// False for models that never produce a tangential force.
-    const ACTIVE: bool;
-    /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
-    /// arms to the contact point in the middle of the overlap.
-    const FULL_RADIUS_LEVER: bool = false;
-    /// The tangential force on P (force units) for a contact with kinematics `k`, signed normal
-    /// force `fn_signed` (positive repulsive), elastic tangential displacement `xi` (length,
-    /// updated in place) and time step `dt` (time).
-    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3;
-}
-
-/// No tangential force at all (mu = 0 or no friction requested).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frictionless;
-
-impl TangentialModel for Frictionless {
-    const ACTIVE: bool = false;
-    #[inline(always)]
-    fn force(&self, _: &PairKinematics, _: f64, _: &mut Vec3, _: f64) -> Vec3 {
-        Vec3::zeros()
-    }
-}
 
 /// MercuryDPM's sliding friction (`SlidingFrictionInteraction::computeFrictionForce`): spring kt
 /// and dashpot γt in parallel, in series with a Coulomb slider that caps the total
@@ -65,6 +45,27 @@ impl TangentialModel for MercurySlidingFriction {
         }
     }
 }
+
+/// LAMMPS `pair_style gran/hooke/history` (with absolute damping): full-radius slip, increment
+/// then project, cap on spring + dashpot, torques with full radii (`torque[i] -= radi*tor`).
+pub type LammpsHookeHistory = Convention<FullRadiusSlip, ProjectAfter, LammpsCap, true>;
+/// LAMMPS `pair_style granular … tangential linear_history`: full-radius slip, project and
+/// rescale then increment, cap on spring + dashpot, torques with R − δ/2 (`dist_to_contact`).
+pub type LammpsGranular = Convention<FullRadiusSlip, ProjectRescale, LammpsCap, false>;
+/// LIGGGHTS 3.8 `tangential history`: slip with R − δ/2, increment then project, cap on the
+/// spring only, dashpot dropped while sliding.
+pub type Liggghts = Convention<HalfOverlapSlip, ProjectAfter, LiggghtsCap, false>;
+/// Yade's `ScGeom` with `avoidGranularRatcheting` (its default): objective slip, first-order
+/// rotation of the spring, torques with R − δ/2; verdem adds the dashpot and cap of the
+/// reference law (Yade's `FrictPhys` has no tangential dashpot).
+pub type YadeApprox = Convention<ObjectiveSlip, FirstOrderRotation, SpringThenTotal, false>;
+/// Cundall & Strack (Géotechnique 29, 47, 1979): full-radius slip, no frame update at all,
+/// torques with full radii.
+pub type Cundall1979 = Convention<FullRadiusSlip, NoFrameUpdate, SpringThenTotal, true>;
+/// The objective reference law: objective slip (at the step's midpoint normal), exact rotation
+/// with the contact frame, elastic part capped and stored, dashpot added and the total capped,
+/// torques with R − δ/2.
+pub type Objective = Convention<MidpointObjectiveSlip, ExactRotation, SpringThenTotal, false>;
 
 #[cfg(test)]
 mod tests {
