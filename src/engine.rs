@@ -62,7 +62,7 @@ where
     }
     let (kt, gammat, mu) = (c.kt, c.gammat, c.mu);
     match c.tangential {
-        Tangential::Mercury => compose(normal, MercurySlidingFriction { kt, gammat, mu }, v),
+        Tangential::Mercury => compose(normal, MercurySlidingFriction::new(kt, gammat, mu), v),
         Tangential::LammpsHookeHistory => {
             compose(normal, LammpsHookeHistory::new(kt, gammat, mu), v)
         }

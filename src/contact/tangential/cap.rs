@@ -1,6 +1,8 @@
 //! Coulomb caps: the tangential force from the spring and the dashpot, limited to mu·|fn|
 //! with the signed normal force fn of the same contact, and the spring reset while sliding.
 
+use std::cmp::Ordering;
+
 use crate::Vec3;
 
 /// The Coulomb cap: the tangential force on P from the spring ξ and the slip, with ξ reset
@@ -13,28 +15,46 @@ pub trait Cap: Send + Sync {
     fn cap(xi: &mut Vec3, slip: Vec3, fcrit: f64, kt: f64, gammat: f64) -> Vec3;
 }
 
-/// Cap spring + dashpot together and reset the spring to match the capped total; a sliding
-/// contact with no stretched spring gets no tangential force (LAMMPS `pair_gran_hooke_history`
-/// and `pair_granular`, "rescale frictional displacements and forces if needed").
+/// Cap spring + dashpot together at mu|fn| and reset the spring to match the capped total.
+/// The sources differ in two details, the parameters: `COMPARE_SQUARES`, the contact slides
+/// when |f|² > (mu fn)² (MercuryDPM) rather than when |f| > mu|fn| (LAMMPS; the two tests
+/// differ in the last bit near the cap); `NO_FORCE_WITHOUT_SPRING`, a sliding contact with no
+/// stretched spring (ξ = 0) gets no tangential force (LAMMPS) rather than the capped dashpot.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct LammpsCap;
+pub struct TotalCap<const COMPARE_SQUARES: bool, const NO_FORCE_WITHOUT_SPRING: bool>;
 
-impl Cap for LammpsCap {
+impl<const COMPARE_SQUARES: bool, const NO_FORCE_WITHOUT_SPRING: bool> Cap
+    for TotalCap<COMPARE_SQUARES, NO_FORCE_WITHOUT_SPRING>
+{
     #[inline(always)]
     fn cap(xi: &mut Vec3, slip: Vec3, fcrit: f64, kt: f64, gammat: f64) -> Vec3 {
         let f = -(kt * *xi + gammat * slip);
-        let magnitude = f.norm();
-        if magnitude <= fcrit {
+        let f2 = f.norm_squared();
+        let sticks = if COMPARE_SQUARES {
+            f2.partial_cmp(&(fcrit * fcrit)) != Some(Ordering::Greater)
+        } else {
+            f2.sqrt() <= fcrit
+        };
+        if sticks {
             return f;
         }
-        if *xi == Vec3::zeros() {
+        if NO_FORCE_WITHOUT_SPRING && *xi == Vec3::zeros() {
             return Vec3::zeros();
         }
-        let capped = f * (fcrit / magnitude);
+        let capped = f * (fcrit / f2.sqrt());
         *xi = -(capped + gammat * slip) / kt;
         capped
     }
 }
+
+/// MercuryDPM's cap (`SlidingFrictionInteraction::computeFrictionForce`): spring + dashpot
+/// against mu|fn|, compared as squares, no guard.
+pub type MercuryCap = TotalCap<true, false>;
+
+/// LAMMPS' cap (`pair_gran_hooke_history` and `pair_granular`, "rescale frictional
+/// displacements and forces if needed"): spring + dashpot against mu|fn|, compared as
+/// magnitudes; no force while sliding with an unstretched spring.
+pub type LammpsCap = TotalCap<false, true>;
 
 /// Cap the spring alone at mu|fn| and drop the dashpot while sliding; the dashpot is added only
 /// while the contact sticks (LIGGGHTS 3.8 `tangential_model_history.h`).

@@ -1,51 +1,18 @@
 //! The named tangential conventions: MercuryDPM's sliding friction, the conventions of peer
 //! codes and the objective reference law.
 
-use super::cap::{LammpsCap, LiggghtsCap, SpringThenTotal};
+use super::cap::{LammpsCap, LiggghtsCap, MercuryCap, SpringThenTotal};
 use super::frame::{
-    ExactRotation, FirstOrderRotation, NoFrameUpdate, ProjectAfter, ProjectRescale,
+    ExactRotation, FirstOrderRotation, NoFrameUpdate, ProjectAfter, ProjectRescale, RateForm,
 };
 use super::slip::{FullRadiusSlip, HalfOverlapSlip, MidpointObjectiveSlip, ObjectiveSlip};
-use super::{Convention, TangentialModel};
-use crate::contact::PairKinematics;
-use crate::Vec3;
+use super::Convention;
 
-/// MercuryDPM's sliding friction (`SlidingFrictionInteraction::computeFrictionForce`): spring kt
-/// and dashpot γt in parallel, in series with a Coulomb slider that caps the total
-/// |kt ξ + γt vt| ≤ mu |fn|.
-///
-/// The spring is integrated in rate form, dξ/dt = vt − (ξ·(v_P − v_I)/|r|) n (its only frame
-/// update: no projection onto the tangent plane, no rescaling, no spin about n). When sliding,
-/// ξ is reset so that spring plus dashpot equal the cap.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MercurySlidingFriction {
-    pub kt: f64,
-    pub gammat: f64,
-    pub mu: f64,
-}
-
-impl TangentialModel for MercurySlidingFriction {
-    const ACTIVE: bool = true;
-
-    #[inline(always)]
-    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3 {
-        // Rate form of the spring for particle pairs (MercuryDPM SlidingFrictionInteraction).
-        let rate = k.vt - k.n * xi.dot(&k.v_centres) / k.dist;
-        *xi += rate * dt;
-        let ft = -(self.kt * *xi + self.gammat * k.vt);
-        let ft2 = ft.norm_squared();
-        let cap = self.mu * fn_signed;
-        if ft2 > cap * cap {
-            // Coulomb: scale the total to mu|fn| and reset the spring to match it.
-            let scaled = ft * (self.mu * fn_signed.abs() / ft2.sqrt());
-            *xi = -(scaled + self.gammat * k.vt) / self.kt;
-            scaled
-        } else {
-            ft
-        }
-    }
-}
-
+/// MercuryDPM's sliding friction (`SlidingFrictionInteraction`), the benchmark's default:
+/// spring kt and dashpot γt in parallel, in series with a Coulomb slider; slip with R − δ/2,
+/// the spring integrated in rate form (its only frame update), spring + dashpot capped at
+/// mu|fn| (compared as squares) and the spring reset to match the cap while sliding.
+pub type MercurySlidingFriction = Convention<HalfOverlapSlip, RateForm, MercuryCap, false>;
 /// LAMMPS `pair_style gran/hooke/history` (with absolute damping): full-radius slip, increment
 /// then project, cap on spring + dashpot, torques with full radii (`torque[i] -= radi*tor`).
 pub type LammpsHookeHistory = Convention<FullRadiusSlip, ProjectAfter, LammpsCap, true>;
@@ -70,7 +37,9 @@ pub type Objective = Convention<MidpointObjectiveSlip, ExactRotation, SpringThen
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::PairInput;
+    use crate::contact::tangential::TangentialModel;
+    use crate::contact::{PairInput, PairKinematics};
+    use crate::Vec3;
 
     fn sliding_pair(vt: f64) -> PairKinematics {
         PairInput {
@@ -86,11 +55,8 @@ mod tests {
         .unwrap()
     }
 
-    const LAW: MercurySlidingFriction = MercurySlidingFriction {
-        kt: 2e5 * 2.0 / 7.0,
-        gammat: 15.0 * 2.0 / 7.0,
-        mu: 0.3,
-    };
+    const LAW: MercurySlidingFriction =
+        MercurySlidingFriction::new(2e5 * 2.0 / 7.0, 15.0 * 2.0 / 7.0, 0.3);
 
     #[test]
     fn sticking_contact_builds_spring_against_the_motion() {

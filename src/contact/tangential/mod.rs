@@ -77,7 +77,7 @@ type Parts<S, U, C> = PhantomData<fn() -> (S, U, C)>;
 impl<S, U, C, const FULL_LEVER: bool> Convention<S, U, C, FULL_LEVER> {
     /// A tangential law with spring `kt` (force/length), dashpot `gammat` (mass/time, absolute)
     /// and Coulomb coefficient `mu`.
-    pub fn new(kt: f64, gammat: f64, mu: f64) -> Self {
+    pub const fn new(kt: f64, gammat: f64, mu: f64) -> Self {
         Convention {
             kt,
             gammat,
@@ -98,13 +98,7 @@ impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
         let slip = S::slip(k, dt);
         let fcrit = self.mu * fn_signed.abs();
         let skip_below = 1e-10 * fcrit / self.kt;
-        if !U::AFTER_INCREMENT {
-            U::update(xi, k, dt, skip_below);
-        }
-        *xi += slip * dt;
-        if U::AFTER_INCREMENT {
-            U::update(xi, k, dt, skip_below);
-        }
+        U::advance(xi, slip, k, dt, skip_below);
         C::cap(xi, slip, fcrit, self.kt, self.gammat)
     }
 }
