@@ -9,10 +9,12 @@
 //! (I receives the opposite).
 
 pub mod normal;
+pub mod registry;
 pub mod tangential;
 
 use crate::Vec3;
 pub use normal::{LinearSpringDashpot, NormalModel};
+pub use registry::{Properties, Tangential, TangentialVisitor};
 pub use tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox,
