@@ -70,7 +70,10 @@ where
     V: LawVisitor,
 {
     type Output = V::Output;
-    fn visit<T: TangentialModel + Clone + 'static>(self, tangential: T) -> V::Output {
+    fn visit<T: TangentialModel<History = Vec3> + Clone + 'static>(
+        self,
+        tangential: T,
+    ) -> V::Output {
         self.v.visit(Composed {
             normal: self.normal,
             tangential,

@@ -138,7 +138,9 @@ pub struct Composed<N, T> {
     pub tangential: T,
 }
 
-impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
+/// The solver stores one `Vec3` of history per contact: a law composes the tangential models
+/// whose history it is.
+impl<N: NormalModel, T: TangentialModel<History = Vec3>> ContactLaw for Composed<N, T> {
     const TANGENTIAL: bool = T::ACTIVE;
 
     #[inline(always)]

@@ -15,6 +15,7 @@ use super::tangential::conventions::{
     YadeApprox,
 };
 use super::TangentialModel;
+use crate::Vec3;
 
 /// What a convention claims about its physics: the verification gates hold each convention to
 /// the rows its properties promise and show the others as documentation of its defects.
@@ -45,11 +46,12 @@ impl Properties {
     };
 }
 
-/// Something done with a tangential model, whichever concrete type the convention names.
+/// Something done with a tangential model, whichever concrete type the convention names (its
+/// history the `Vec3` the solver stores).
 pub trait TangentialVisitor {
     type Output;
     /// Does the job with the tangential model `model`.
-    fn visit<T: TangentialModel + Clone + 'static>(self, model: T) -> Self::Output;
+    fn visit<T: TangentialModel<History = Vec3> + Clone + 'static>(self, model: T) -> Self::Output;
 }
 
 /// Generates [`Tangential`] and its table from the entries

@@ -30,17 +30,20 @@ use frame::FrameUpdate;
 use slip::Slip;
 
 /// A tangential model. `fn_signed` is the signed normal force of the same contact; `xi` is the
-/// contact's elastic tangential displacement (length), updated in place over the step `dt`.
+/// contact's history, updated in place over the step `dt`.
 pub trait TangentialModel: Send + Sync {
+    /// What a contact carries from step to step: the elastic tangential displacement ξ
+    /// (length) for every model so far.
+    type History: Copy + Default + Send + Sync + 'static;
     /// False for models that never produce a tangential force.
     const ACTIVE: bool;
     /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
     /// arms to the contact point in the middle of the overlap.
     const FULL_RADIUS_LEVER: bool = false;
     /// The tangential force on P (force units) for a contact with kinematics `k`, signed normal
-    /// force `fn_signed` (positive repulsive), elastic tangential displacement `xi` (length,
-    /// updated in place) and time step `dt` (time).
-    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3;
+    /// force `fn_signed` (positive repulsive), history `xi` (updated in place) and time step
+    /// `dt` (time).
+    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Self::History, dt: f64) -> Vec3;
 }
 
 /// No tangential force at all (mu = 0 or no friction requested).
@@ -48,6 +51,7 @@ pub trait TangentialModel: Send + Sync {
 pub struct Frictionless;
 
 impl TangentialModel for Frictionless {
+    type History = Vec3;
     const ACTIVE: bool = false;
     #[inline(always)]
     fn force(&self, _: &PairKinematics, _: f64, _: &mut Vec3, _: f64) -> Vec3 {
@@ -90,6 +94,7 @@ impl<S, U, C, const FULL_LEVER: bool> Convention<S, U, C, FULL_LEVER> {
 impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
     for Convention<S, U, C, FULL_LEVER>
 {
+    type History = Vec3;
     const ACTIVE: bool = true;
     const FULL_RADIUS_LEVER: bool = FULL_LEVER;
 
