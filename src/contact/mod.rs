@@ -1,12 +1,13 @@
 //! Contact laws composed of small parts: a normal force model and a tangential model (spring,
 //! dashpot and Coulomb cap). A variant is a new part, chosen once when the simulation is built,
-//! never an `if` in the pair loop.
+//! never an `if` in the pair loop. The tangential conventions a case can name are listed,
+//! with the properties they claim, in [`registry`].
 //!
 //! Conventions (MercuryDPM, `BaseInteraction` and `SlidingFrictionInteraction`; see
-//! `benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I the
-//! higher; the unit normal `n` points from I to P; the overlap `δ = r_P + r_I − |x_P − x_I|` is
-//! positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on P
-//! (I receives the opposite).
+//! `docs/benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I
+//! the higher; the unit normal `n` points from I to P; the overlap `δ = r_P + r_I − |x_P − x_I|`
+//! is positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on
+//! P (I receives the opposite).
 
 pub mod normal;
 pub mod registry;

@@ -57,7 +57,9 @@ pub trait TangentialVisitor {
 /// Generates [`Tangential`] and its table from the entries
 /// `Variant = "name", Model, [properties], "description";`.
 macro_rules! conventions {
-    ($($variant:ident = $name:literal, $model:ty, [$($property:ident),*], $description:literal;)*) => {
+    ($(
+        $variant:ident = $name:literal, $model:ty, [$($property:ident),*], $description:literal;
+    )*) => {
         /// A tangential contact convention, named in a case's `[contact] tangential`.
         #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
         pub enum Tangential {
