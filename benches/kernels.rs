@@ -45,11 +45,7 @@ fn pair_kernel(c: &mut Criterion) {
             kn: 2e5,
             gamman: 15.0,
         },
-        tangential: MercurySlidingFriction {
-            kt: 2e5 * 2.0 / 7.0,
-            gammat: 15.0 * 2.0 / 7.0,
-            mu: 0.3,
-        },
+        tangential: MercurySlidingFriction::new(2e5 * 2.0 / 7.0, 15.0 * 2.0 / 7.0, 0.3),
     };
     let input = PairInput {
         r: Vec3::new(0.1, 0.2, 0.97),

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+pub use crate::contact::Tangential;
+
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
 #[error("{file}:{line}: {field}: {msg}")]
@@ -125,67 +127,6 @@ pub struct Material {
     pub density: f64,
     /// Particle diameter (length).
     pub diameter: f64,
-}
-
-/// Tangential contact conventions.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum Tangential {
-    /// MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring +
-    /// dashpot.
-    Mercury,
-    /// LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms.
-    LammpsHookeHistory,
-    /// LAMMPS `granular … tangential linear_history`: project and rescale, then increment.
-    LammpsGranular,
-    /// LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while
-    /// sliding.
-    Liggghts,
-    /// Yade's first-order rotation of the spring with the objective slip.
-    Yade,
-    /// Cundall & Strack 1979: no frame update at all.
-    Cundall,
-    /// The objective reference law: exact rotation with the contact frame, objective slip.
-    Objective,
-}
-
-impl Tangential {
-    /// Every convention, in the order of the verification table.
-    pub const ALL: [Tangential; 7] = [
-        Tangential::Mercury,
-        Tangential::LammpsHookeHistory,
-        Tangential::LammpsGranular,
-        Tangential::Liggghts,
-        Tangential::Yade,
-        Tangential::Cundall,
-        Tangential::Objective,
-    ];
-
-    /// The name used in case files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Tangential::Mercury => "mercury",
-            Tangential::LammpsHookeHistory => "lammps-hooke-history",
-            Tangential::LammpsGranular => "lammps-granular",
-            Tangential::Liggghts => "liggghts",
-            Tangential::Yade => "yade",
-            Tangential::Cundall => "cundall",
-            Tangential::Objective => "objective",
-        }
-    }
-
-    /// One line saying what the convention does and whose it is (for help texts).
-    pub fn description(self) -> &'static str {
-        match self {
-            Tangential::Mercury => "MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring + dashpot",
-            Tangential::LammpsHookeHistory => "LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms",
-            Tangential::LammpsGranular => "LAMMPS `granular … tangential linear_history`: project and rescale, then increment",
-            Tangential::Liggghts => "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding",
-            Tangential::Yade => "Yade's first-order rotation of the spring with the objective slip",
-            Tangential::Cundall => "Cundall & Strack 1979: no frame update at all",
-            Tangential::Objective => "The objective reference law: exact rotation with the contact frame, objective slip",
-        }
-    }
 }
 
 /// `[contact]`: the contact law.

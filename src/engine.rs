@@ -1,12 +1,11 @@
 //! Builds a simulation from a case: the contact law is composed here, once, from the parts the
 //! case switches on (friction or not, tangential convention, clipped normal force or not).
 
-use crate::case::{self, Case, Tangential};
+use crate::case::{self, Case};
 use crate::contact::normal::Clipped;
 use crate::contact::{
-    Composed, ContactLaw, Cundall1979, Frictionless, LammpsGranular, LammpsHookeHistory, Liggghts,
-    LinearSpringDashpot, MercurySlidingFriction, NormalModel, Objective, TangentialModel,
-    YadeApprox,
+    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, TangentialModel,
+    TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
@@ -49,28 +48,33 @@ where
     N: NormalModel + Clone + 'static,
     V: LawVisitor,
 {
-    fn compose<N, T, V>(normal: N, tangential: T, v: V) -> V::Output
-    where
-        N: NormalModel + Clone + 'static,
-        T: TangentialModel + Clone + 'static,
-        V: LawVisitor,
-    {
-        v.visit(Composed { normal, tangential })
-    }
     if c.mu <= 0.0 {
-        return compose(normal, Frictionless, v);
+        return v.visit(Composed {
+            normal,
+            tangential: Frictionless,
+        });
     }
-    let (kt, gammat, mu) = (c.kt, c.gammat, c.mu);
-    match c.tangential {
-        Tangential::Mercury => compose(normal, MercurySlidingFriction { kt, gammat, mu }, v),
-        Tangential::LammpsHookeHistory => {
-            compose(normal, LammpsHookeHistory::new(kt, gammat, mu), v)
-        }
-        Tangential::LammpsGranular => compose(normal, LammpsGranular::new(kt, gammat, mu), v),
-        Tangential::Liggghts => compose(normal, Liggghts::new(kt, gammat, mu), v),
-        Tangential::Yade => compose(normal, YadeApprox::new(kt, gammat, mu), v),
-        Tangential::Cundall => compose(normal, Cundall1979::new(kt, gammat, mu), v),
-        Tangential::Objective => compose(normal, Objective::new(kt, gammat, mu), v),
+    c.tangential
+        .with_model(c.kt, c.gammat, c.mu, ComposeWith { normal, v })
+}
+
+/// Composes a normal model with the tangential model the registry builds, for a visitor.
+struct ComposeWith<N, V> {
+    normal: N,
+    v: V,
+}
+
+impl<N, V> TangentialVisitor for ComposeWith<N, V>
+where
+    N: NormalModel + Clone + 'static,
+    V: LawVisitor,
+{
+    type Output = V::Output;
+    fn visit<T: TangentialModel + Clone + 'static>(self, tangential: T) -> V::Output {
+        self.v.visit(Composed {
+            normal: self.normal,
+            tangential,
+        })
     }
 }
 

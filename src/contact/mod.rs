@@ -1,25 +1,28 @@
 //! Contact laws composed of small parts: a normal force model and a tangential model (spring,
 //! dashpot and Coulomb cap). A variant is a new part, chosen once when the simulation is built,
-//! never an `if` in the pair loop.
+//! never an `if` in the pair loop. The tangential conventions a case can name are listed,
+//! with the properties they claim, in [`registry`].
 //!
 //! Conventions (MercuryDPM, `BaseInteraction` and `SlidingFrictionInteraction`; see
-//! `benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I the
-//! higher; the unit normal `n` points from I to P; the overlap `δ = r_P + r_I − |x_P − x_I|` is
-//! positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on P
-//! (I receives the opposite).
+//! `docs/benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I
+//! the higher; the unit normal `n` points from I to P; the overlap `δ = r_P + r_I − |x_P − x_I|`
+//! is positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on
+//! P (I receives the opposite).
 
-pub mod conventions;
 pub mod normal;
+pub mod registry;
 pub mod tangential;
 
 use crate::state::History;
 pub use crate::state::PairForce;
 use crate::Vec3;
-pub use conventions::{
-    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, Objective, YadeApprox,
-};
 pub use normal::{LinearSpringDashpot, NormalModel};
-pub use tangential::{Frictionless, MercurySlidingFriction, TangentialModel};
+pub use registry::{Properties, Tangential, TangentialVisitor};
+pub use tangential::conventions::{
+    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
+    YadeApprox,
+};
+pub use tangential::{Frictionless, TangentialModel};
 
 /// Kinematics of one pair in contact, evaluated at the contact point.
 #[derive(Clone, Copy, Debug)]
@@ -128,13 +131,15 @@ pub struct Composed<N, T> {
     pub tangential: T,
 }
 
+/// The solver stores one `Vec3` of history per contact: a law composes the tangential models
+/// whose history it is.
 impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
     const TANGENTIAL: bool = T::ACTIVE;
-    /// The elastic tangential displacement ξ (length); zero for a frictionless law.
-    type History = Vec3;
+    /// The tangential model's history (the normal models keep none).
+    type History = T::History;
 
     #[inline(always)]
-    fn evaluate(&self, k: &PairKinematics, xi: &mut Vec3, dt: f64) -> PairForce {
+    fn evaluate(&self, k: &PairKinematics, xi: &mut T::History, dt: f64) -> PairForce {
         let fn_signed = self.normal.force(k.delta, k.vn);
         if T::ACTIVE {
             let ft = self.tangential.force(k, fn_signed, xi, dt);

@@ -173,9 +173,7 @@ pub fn rows(base: &Case, steps: u64) -> anyhow::Result<Vec<Row>> {
             dl,
             1e-12,
         );
-        let full_radius_lever =
-            matches!(conv, Tangential::LammpsHookeHistory | Tangential::Cundall);
-        rows.push(r.gating_if(!full_radius_lever));
+        rows.push(r.gating_if(conv.properties().conserves_angular_momentum));
     }
     Ok(rows)
 }

@@ -85,10 +85,11 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
                     beta,
                     1e-2,
                 );
-                // LIGGGHTS caps the spring alone against mu|Fn|: near the end of the contact,
-                // where Fn (with its dashpot) vanishes before δ, the contact slides even below
-                // psi = 7mu/2; the sticking answer is documented, not required, for it.
-                rows.push(r.gating_if(conv != Tangential::Liggghts));
+                // A cap on the spring alone, without the dashpot while sliding (LIGGGHTS):
+                // near the end of the contact, where Fn (with its dashpot) vanishes before δ,
+                // the contact slides even below psi = 7mu/2; the sticking answer is
+                // documented, not required, for such a convention.
+                rows.push(r.gating_if(!conv.properties().drops_dashpot_while_sliding));
             } else if psi >= 3.5 * mu * (1.0 + cf.e_clipped) {
                 let (beta, ratio) = on_wall(&clipped, vn, vt, 0.0)?;
                 let case = format!("oblique {name} {deg}deg psi={psi:.3} slide clipped");

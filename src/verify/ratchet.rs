@@ -8,7 +8,7 @@
 //! elastic contact must return to its initial (zero) force with zero net work. A slip that is
 //! not objective deposits a spurious displacement −δ·Ω×n·dt during the rigid rotations (δ the
 //! overlap, i.e. fn/kn), which the two rotations cancel only to O(δ·a·dx). A spring that does
-//! not twist with the contact (every convention but Yade's and the objective law) is left
+//! not twist with the contact (a convention without the `twists_spring` property) is left
 //! turned by the rotation's twist: a residual ≈ kt·dx·a whatever the load, which dominates the
 //! δ-part here. The rotation is a = 0.1 rad, so that no convention reaches the sliding limit
 //! (a full-radius slip adds −δ·a to the spring while the pair turns).
@@ -114,7 +114,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             let twice = cycle(&case, axis, 2.0 * overlap, dx)?;
             let energy = c.peak * c.peak / (2.0 * case.contact.kt);
             let name = format!("ratchet {} {label}", conv.name());
-            let gate = |r: Row| r.gating_if(conv == Tangential::Objective);
+            let gate = |r: Row| r.gating_if(conv.properties().objective);
             let (res, work) = (c.residual / c.peak, c.work / energy);
             rows.push(gate(row_abs(
                 &name,
@@ -133,8 +133,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             // A spring that does not twist with the pair is left turned by the rotation's
             // twist, ≈ a·cos θ, wherever the translations put it: a residual ≈ kt·dx·a,
             // independent of the load.
-            let twists = matches!(conv, Tangential::Yade | Tangential::Objective);
-            if !twists && label == "rotation about n" {
+            if !conv.properties().twists_spring && label == "rotation about n" {
                 rows.push(row_abs(
                     &name,
                     "load exponent of the residual (fn x2)",

@@ -1,0 +1,165 @@
+//! The registry of tangential conventions: one entry per convention a case can name, giving
+//! the name used in case files and on the command line, the tangential model (a type built by
+//! `new(kt, gammat, mu)`), the properties it claims and a one-line description. The case
+//! parser, the law composition, the verification gates and the command line's help all read
+//! this table: adding a convention is one entry here, plus a file of parts under
+//! [`super::tangential`] if it needs new ones.
+//!
+//! Only the properties an entry lists are true; whether its torques conserve angular momentum
+//! follows from its model's lever arms ([`TangentialModel::FULL_RADIUS_LEVER`]).
+
+use serde::Deserialize;
+
+use super::tangential::conventions::{
+    Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
+    YadeApprox,
+};
+use super::TangentialModel;
+
+/// What a convention claims about its physics: the verification gates hold each convention to
+/// the rows its properties promise and show the others as documentation of its defects.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Properties {
+    /// Objective to second order per step: a rigid rotation of a loaded contact keeps |Fn| and
+    /// |Ft| and turns Ft with the pair, and a closed cycle of relative motion below the sliding
+    /// limit returns to zero force with zero net work (McNamara et al. 2008).
+    pub objective: bool,
+    /// The stored spring twists with the pair about the contact normal (by the mean spin
+    /// about n); a spring that does not is left turned by a rotation about n.
+    pub twists_spring: bool,
+    /// While sliding the force is the capped spring alone, without the dashpot; the contact
+    /// then slides at the end of an impact even below Walton's sticking limit ψ = 7mu/2.
+    pub drops_dashpot_while_sliding: bool,
+    /// The torques' lever arms reach the contact point where the force acts (R − δ/2), so a
+    /// contact conserves angular momentum; full radii leave δ n × Ft per contact.
+    pub conserves_angular_momentum: bool,
+}
+
+impl Properties {
+    /// No property at all.
+    pub const NONE: Properties = Properties {
+        objective: false,
+        twists_spring: false,
+        drops_dashpot_while_sliding: false,
+        conserves_angular_momentum: false,
+    };
+}
+
+/// Something done with a tangential model, whichever concrete type the convention names (its
+/// history the `Vec3` the solver stores).
+pub trait TangentialVisitor {
+    type Output;
+    /// Does the job with the tangential model `model`.
+    fn visit<T: TangentialModel + Clone + 'static>(self, model: T) -> Self::Output;
+}
+
+/// Generates [`Tangential`] and its table from the entries
+/// `Variant = "name", Model, [properties], "description";`.
+macro_rules! conventions {
+    ($(
+        $variant:ident = $name:literal, $model:ty, [$($property:ident),*], $description:literal;
+    )*) => {
+        /// A tangential contact convention, named in a case's `[contact] tangential`.
+        #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+        pub enum Tangential {
+            $(
+                #[doc = $description]
+                #[serde(rename = $name)]
+                $variant,
+            )*
+        }
+
+        impl Tangential {
+            /// Every convention, in the registry's order (that of the verification table).
+            pub const ALL: [Tangential; [$($name),*].len()] = [$(Tangential::$variant),*];
+
+            /// The name used in case files and on the command line.
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $(Tangential::$variant => $name,)*
+                }
+            }
+
+            /// The convention named `name` in case files, if any.
+            pub fn named(name: &str) -> Option<Tangential> {
+                Tangential::ALL.into_iter().find(|t| t.name() == name)
+            }
+
+            /// One line saying what the convention does and whose it is.
+            pub const fn description(self) -> &'static str {
+                match self {
+                    $(Tangential::$variant => $description,)*
+                }
+            }
+
+            /// What the convention claims (see [`Properties`]).
+            pub const fn properties(self) -> Properties {
+                match self {
+                    $(Tangential::$variant => {
+                        let mut p = Properties::NONE;
+                        $(p.$property = true;)*
+                        p.conserves_angular_momentum =
+                            !<$model as TangentialModel>::FULL_RADIUS_LEVER;
+                        p
+                    })*
+                }
+            }
+
+            /// Builds the convention's tangential model with spring `kt` (force/length),
+            /// dashpot `gammat` (mass/time, absolute) and Coulomb coefficient `mu`, and hands
+            /// it to `v`.
+            pub fn with_model<V: TangentialVisitor>(
+                self,
+                kt: f64,
+                gammat: f64,
+                mu: f64,
+                v: V,
+            ) -> V::Output {
+                match self {
+                    $(Tangential::$variant => v.visit(<$model>::new(kt, gammat, mu)),)*
+                }
+            }
+        }
+    };
+}
+
+conventions! {
+    Mercury = "mercury", MercurySlidingFriction, [],
+        "MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring + dashpot";
+    LammpsHookeHistory = "lammps-hooke-history", LammpsHookeHistory, [],
+        "LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms";
+    LammpsGranular = "lammps-granular", LammpsGranular, [],
+        "LAMMPS `granular … tangential linear_history`: project and rescale, then increment";
+    Liggghts = "liggghts", Liggghts, [drops_dashpot_while_sliding],
+        "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding";
+    Yade = "yade", YadeApprox, [twists_spring],
+        "Yade's first-order rotation of the spring with the objective slip";
+    Cundall = "cundall", Cundall1979, [],
+        "Cundall & Strack 1979: no frame update at all";
+    Objective = "objective", Objective, [objective, twists_spring],
+        "The objective reference law: exact rotation with the contact frame, objective slip";
+}
+
+/// The name and description of every convention, in the registry's order (for help texts).
+pub fn listing() -> impl Iterator<Item = (&'static str, &'static str)> {
+    Tangential::ALL
+        .into_iter()
+        .map(|t| (t.name(), t.description()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_the_full_radius_conventions_do_not_conserve_angular_momentum() {
+        let names: std::collections::BTreeSet<_> = listing().map(|(n, _)| n).collect();
+        assert_eq!(names.len(), Tangential::ALL.len());
+        let lossy: Vec<_> = Tangential::ALL
+            .into_iter()
+            .filter(|t| !t.properties().conserves_angular_momentum)
+            .collect();
+        assert_eq!(lossy, [Tangential::LammpsHookeHistory, Tangential::Cundall]);
+        assert!(Tangential::Objective.properties().objective);
+    }
+}

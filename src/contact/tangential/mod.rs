@@ -1,0 +1,126 @@
+//! Tangential models: elastic spring ξ stored per contact, dashpot and Coulomb cap. The
+//! returned vector is the tangential force on P.
+//!
+//! The tangential conventions of peer codes and an objective reference law are each composed
+//! of three parts chosen once at build time: the slip ([`slip`]: how the relative tangential
+//! velocity at the contact is formed), the frame update ([`frame`]: how the stored spring
+//! follows the turning contact plane) and the Coulomb cap ([`cap`]). The compositions are named
+//! in [`conventions`].
+//!
+//! Conventions as in the rest of [`super`]: n points from I to P; the slip is the velocity of
+//! P's material point at the contact relative to I's, tangential part; the spring ξ (length) is
+//! stored so that its elastic force on P is −kt ξ; the cap is mu·|fn| with the signed normal
+//! force fn of the same contact.
+//!
+//! The frame updates that rotate the spring need the previous normal. verdem does not store it:
+//! its drift moved both centres by exactly v·dt with the half-step velocities the law sees, so
+//! the previous separation is r − (v_P − v_I)·dt, to rounding ([`previous_normal`]).
+
+pub mod cap;
+pub mod conventions;
+pub mod frame;
+pub mod slip;
+
+use std::marker::PhantomData;
+
+use super::PairKinematics;
+use crate::Vec3;
+use cap::Cap;
+use frame::FrameUpdate;
+use slip::Slip;
+
+/// A tangential model. `fn_signed` is the signed normal force of the same contact; `xi` is the
+/// contact's history, updated in place over the step `dt`.
+pub trait TangentialModel: Send + Sync {
+    /// What a contact carries from step to step: the elastic tangential displacement ξ
+    /// (length) for every model so far.
+    type History: crate::state::History;
+    /// False for models that never produce a tangential force.
+    const ACTIVE: bool;
+    /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
+    /// arms to the contact point in the middle of the overlap.
+    const FULL_RADIUS_LEVER: bool = false;
+    /// The tangential force on P (force units) for a contact with kinematics `k`, signed normal
+    /// force `fn_signed` (positive repulsive), history `xi` (updated in place) and time step
+    /// `dt` (time).
+    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Self::History, dt: f64) -> Vec3;
+}
+
+/// No tangential force at all (mu = 0 or no friction requested).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frictionless;
+
+impl TangentialModel for Frictionless {
+    type History = Vec3;
+    const ACTIVE: bool = false;
+    #[inline(always)]
+    fn force(&self, _: &PairKinematics, _: f64, _: &mut Vec3, _: f64) -> Vec3 {
+        Vec3::zeros()
+    }
+}
+
+/// The normal of the previous step, n_old = (r − (v_P − v_I)·dt)/|…| (unit, from I to P).
+#[inline(always)]
+pub fn previous_normal(k: &PairKinematics, dt: f64) -> Vec3 {
+    (k.r - k.v_centres * dt).normalize()
+}
+
+/// A tangential spring kt (force/length), dashpot γt (mass/time) and Coulomb slider mu, made of
+/// a slip `S`, a frame update `U` and a cap `C`; torques use full radii when `FULL_LEVER`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Convention<S, U, C, const FULL_LEVER: bool> {
+    pub kt: f64,
+    pub gammat: f64,
+    pub mu: f64,
+    parts: Parts<S, U, C>,
+}
+
+/// The parts of a [`Convention`], held by type only (no data, `Send + Sync` whatever they are).
+type Parts<S, U, C> = PhantomData<fn() -> (S, U, C)>;
+
+impl<S, U, C, const FULL_LEVER: bool> Convention<S, U, C, FULL_LEVER> {
+    /// A tangential law with spring `kt` (force/length), dashpot `gammat` (mass/time, absolute)
+    /// and Coulomb coefficient `mu`.
+    pub const fn new(kt: f64, gammat: f64, mu: f64) -> Self {
+        Convention {
+            kt,
+            gammat,
+            mu,
+            parts: PhantomData,
+        }
+    }
+}
+
+impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
+    for Convention<S, U, C, FULL_LEVER>
+{
+    type History = Vec3;
+    const ACTIVE: bool = true;
+    const FULL_RADIUS_LEVER: bool = FULL_LEVER;
+
+    #[inline(always)]
+    fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3 {
+        let slip = S::slip(k, dt);
+        let fcrit = self.mu * fn_signed.abs();
+        let skip_below = 1e-10 * fcrit / self.kt;
+        U::advance(xi, slip, k, dt, skip_below);
+        C::cap(xi, slip, fcrit, self.kt, self.gammat)
+    }
+}
+
+/// The kinematics of a pair of spheres of radius 0.5 at separation `r` (I at rest at the
+/// origin), for the parts' tests.
+#[cfg(test)]
+pub(crate) fn test_kinematics(r: Vec3, v_p: Vec3, w_p: Vec3, w_i: Vec3) -> PairKinematics {
+    crate::contact::PairInput {
+        r,
+        rad_p: 0.5,
+        rad_i: 0.5,
+        v_p,
+        v_i: Vec3::zeros(),
+        w_p,
+        w_i,
+    }
+    .kinematics()
+    .unwrap()
+}
