@@ -35,7 +35,7 @@ fn developed(threads: usize) -> (Case, Box<dyn Engine>) {
             ..Overrides::default()
         },
     );
-    e.advance(1);
+    e.advance(1).unwrap();
     (case, e)
 }
 

@@ -149,7 +149,7 @@ pub fn run(
                                     ..Overrides::default()
                                 },
                             );
-                            e.advance(0);
+                            e.advance(0)?;
                             *e.counters_mut() = StageTimes::default();
                             e.params_mut().meet = barrier
                                 .clone()
@@ -163,8 +163,10 @@ pub fn run(
                         let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
                         start.wait();
                         let t0 = Instant::now();
-                        advance_in_chunks(e, steps);
-                        steps as f64 / t0.elapsed().as_secs_f64()
+                        advance_in_chunks(e, steps)?;
+                        Ok::<f64, crate::step::guard::Failure>(
+                            steps as f64 / t0.elapsed().as_secs_f64(),
+                        )
                     };
                     let own: Vec<f64> = std::thread::scope(|s| {
                         let (first, rest) = engines.split_at_mut(1);
@@ -178,8 +180,8 @@ pub fn run(
                             .collect();
                         let mut own = vec![time_copy(0, first[0].as_mut())];
                         own.extend(others.into_iter().map(|h| h.join().expect("copy runs")));
-                        own
-                    });
+                        own.into_iter().collect::<Result<Vec<f64>, _>>()
+                    })?;
                     m.rates.push(own.iter().sum());
                     if copies > 1 {
                         m.copy_rates.push(own);
@@ -205,13 +207,17 @@ pub fn run(
 }
 
 /// Advances `steps` steps in chunks as a run does (progress and saves happen between them).
-fn advance_in_chunks(e: &mut dyn crate::step::Engine, steps: u64) {
+fn advance_in_chunks(
+    e: &mut dyn crate::step::Engine,
+    steps: u64,
+) -> Result<(), crate::step::guard::Failure> {
     let mut left = steps;
     while left > 0 {
         let k = left.min(2000);
-        e.advance(k);
+        e.advance(k)?;
         left -= k;
     }
+    Ok(())
 }
 
 /// The rate of `b` over that of `a` in each round (paired: the runs of one round are seconds

@@ -87,6 +87,7 @@ struct BuildSimulation {
     builder: NeighborBuilder,
     threads: usize,
     bind: bool,
+    overlap: f64,
 }
 
 impl LawVisitor for BuildSimulation {
@@ -102,6 +103,7 @@ impl LawVisitor for BuildSimulation {
         );
         core.state.time = self.scene.time;
         core.params.bind = self.bind;
+        core.params.guard.overlap = self.overlap;
         Box::new(Simulation::new(law, core))
     }
 }
@@ -122,6 +124,7 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         builder,
         threads: o.threads.unwrap_or(case.run.threads),
         bind: o.bind.unwrap_or(true),
+        overlap: case.guard.overlap,
     };
     with_law(&case.contact, parts)
 }

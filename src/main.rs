@@ -5,7 +5,7 @@ mod cli;
 
 use clap::{Parser, Subcommand};
 
-use cli::{Finished, EXIT_INTERRUPTED};
+use cli::{Finished, EXIT_GUARD, EXIT_INTERRUPTED};
 
 #[derive(Parser)]
 #[command(
@@ -70,7 +70,8 @@ fn main() {
         Ok(Finished::ChecksFailed) => std::process::exit(1),
         Err(e) => {
             eprintln!("error: {e:#}");
-            std::process::exit(1);
+            let guard = e.downcast_ref::<verdem::step::guard::Failure>().is_some();
+            std::process::exit(if guard { EXIT_GUARD } else { 1 });
         }
     }
 }

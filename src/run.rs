@@ -119,13 +119,15 @@ pub fn run(
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
+    // What a stop by the run guard leaves: the last save and checkpoint of this run.
+    let mut kept = Kept::default();
     let interrupted = loop {
         let step = engine.state().step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
             if !engine.state().forces_ready {
-                engine.advance(0);
+                engine.advance(0).map_err(|f| kept.stopped(f))?;
             }
-            write_save(engine, opts, &diag)?;
+            kept.save = Some(write_save(engine, opts, &diag)?);
             saves += 1;
         }
         if opts.checkpoint_every > 0
@@ -133,6 +135,7 @@ pub fn run(
             && step != start_step
         {
             write_checkpoint(engine, opts)?;
+            kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
         }
         first = false;
         if step >= opts.end_step {
@@ -153,7 +156,7 @@ pub fn run(
         if let Some(k) = step.checked_div(opts.checkpoint_every) {
             next = next.min((k + 1) * opts.checkpoint_every);
         }
-        engine.advance(next - step);
+        engine.advance(next - step).map_err(|f| kept.stopped(f))?;
         if let Some(b) = &bar {
             b.set_position(engine.state().step);
             b.set_message(format!("t = {:.3}", engine.state().time));
@@ -184,7 +187,31 @@ fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()
     )
 }
 
-fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<()> {
+/// The files a run has written that a stop by the run guard leaves intact.
+#[derive(Default)]
+struct Kept {
+    save: Option<PathBuf>,
+    checkpoint: Option<PathBuf>,
+}
+
+impl Kept {
+    /// The error of a run stopped by the run guard: its failure and what is kept on disk.
+    fn stopped(&self, mut f: crate::step::guard::Failure) -> anyhow::Error {
+        let name = |p: &Option<PathBuf>| {
+            p.as_ref()
+                .map_or("none".to_string(), |p| p.display().to_string())
+        };
+        f.kept = Some(format!(
+            "nothing was written after the last good state: last save {}, last checkpoint {}",
+            name(&self.save),
+            name(&self.checkpoint)
+        ));
+        anyhow::Error::new(f)
+    }
+}
+
+/// Writes the save of the current step; returns the path of its `.data` file.
+fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<PathBuf> {
     let core = &engine.snapshot();
     let k = core.step / opts.save_every;
     let data = mercury::save_path(&opts.out_dir, &opts.name, "data", k);
@@ -194,7 +221,8 @@ fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Re
     atomic::write(&fstat, mercury::fstat_text(core).as_bytes())
         .with_context(|| format!("{}: cannot write", fstat.display()))?;
     atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())
-        .with_context(|| format!("{}: cannot append", diag.display()))
+        .with_context(|| format!("{}: cannot append", diag.display()))?;
+    Ok(data)
 }
 
 /// A fresh run starts a new table; a resumed one keeps the rows up to its step, which must have

@@ -36,10 +36,10 @@ fn steady_state_steps_allocate_nothing() {
         Default::default(),
     );
     // warm up: several pair-list rebuilds size every buffer
-    e.advance(20_000);
+    e.advance(20_000).unwrap();
     let count = |e: &mut Box<dyn verdem::step::Engine>, steps| {
         let before = ALLOCATIONS.load(Ordering::Relaxed);
-        e.advance(steps);
+        e.advance(steps).unwrap();
         ALLOCATIONS.load(Ordering::Relaxed) - before
     };
     let one = count(&mut e, 1);

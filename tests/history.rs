@@ -78,7 +78,7 @@ fn two_spheres() -> Simulation<AgingLaw> {
 #[test]
 fn a_four_word_history_is_snapshotted_hashed_and_checkpointed() {
     let mut sim = two_spheres();
-    sim.advance(60);
+    sim.advance(60).unwrap();
     let snap = sim.snapshot();
     assert_eq!(snap.contacts.len(), 1, "the spheres touch after 60 steps");
     let words = &snap.contacts[0].history;
@@ -99,11 +99,11 @@ fn a_four_word_history_is_snapshotted_hashed_and_checkpointed() {
     let ck = dir.path().join("aging.checkpoint");
     verdem::io::checkpoint::write(&ck, &snap, 1e-3, "aging:2").unwrap();
     let mut resumed = two_spheres();
-    resumed.advance(0);
+    resumed.advance(0).unwrap();
     verdem::io::checkpoint::read(&ck, &mut resumed, "aging:2").unwrap();
     assert_eq!(resumed.snapshot().contacts[0].history, *words);
-    sim.advance(5);
-    resumed.advance(5);
+    sim.advance(5).unwrap();
+    resumed.advance(5).unwrap();
     assert_eq!(
         verdem::io::hash::state_hash(&sim.snapshot()),
         verdem::io::hash::state_hash(&resumed.snapshot())

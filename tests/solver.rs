@@ -19,7 +19,7 @@ fn reproduces_mercurydpm_contact_at_save_1() {
         Some(&data("outputs_example/Mercury_out.data.0000")),
         Overrides::default(),
     );
-    e.advance(50_000);
+    e.advance(50_000).unwrap();
     let snap = e.snapshot();
     assert!((snap.time - 3.596272516).abs() < 1e-9, "time {}", snap.time);
     let dir = tempfile::tempdir().unwrap();
@@ -113,7 +113,7 @@ fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
                     let mut e = engine(case, Some(state), Overrides::default());
                     e.params_mut().meet = Some(std::sync::Arc::new(move || barrier.wait()));
                     // several calls, each a run of its own (the first with a rebuild)
-                    e.advance(300);
+                    e.advance(300).unwrap();
                     hash_after(e.as_mut(), 400)
                 })
             })
@@ -150,7 +150,7 @@ fn reordered_force_summation_changes_the_hash() {
         Some(&data("states/mercury_t143.85.data")),
         Overrides::default(),
     );
-    e.advance(100);
+    e.advance(100).unwrap();
     let snap = e.snapshot();
     let terms: Vec<_> = snap.contacts.iter().map(|c| c.force.f).collect();
     assert!(terms.len() >= 3);

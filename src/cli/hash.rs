@@ -15,7 +15,7 @@ pub struct Args {
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let (_, mut engine) = a.common.load()?;
-    engine.advance(a.steps);
+    engine.advance(a.steps)?;
     println!("{}", hash::state_hash(&engine.snapshot()));
     Ok(Finished::Done)
 }

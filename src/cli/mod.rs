@@ -17,6 +17,10 @@ pub mod verify;
 /// shell reports a process that SIGINT ended).
 pub const EXIT_INTERRUPTED: i32 = 130;
 
+/// Exit status of a run the run guard stopped: a number it could no longer trust (a
+/// non-finite velocity, an overlap beyond the limit, a particle outside the box).
+pub const EXIT_GUARD: i32 = 3;
+
 /// How a command ended, when it did not fail.
 pub enum Finished {
     Done,

@@ -142,7 +142,7 @@ pub fn cross(
     };
     let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
     e.params_mut().setup_advances_history = peer.setup_advances_history();
-    e.advance(0);
+    e.advance(0)?;
     let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
     for d in [&peer_dir, &own_dir] {
         std::fs::create_dir_all(d).with_context(|| d.display().to_string())?;
@@ -153,7 +153,7 @@ pub fn cross(
     let mut saves = Vec::new();
     for k in 0..=steps / every {
         if k > 0 {
-            e.advance(every);
+            e.advance(every)?;
         }
         let own = e.snapshot();
         let name = format!("{}.data.{k:04}", case.name);

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use super::counters::StageTimes;
+use super::guard::{Failure, GuardLimits};
 use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
 use crate::neighbor::NeighborBuilder;
 use crate::state::{Contact, Domain, History, Particles, Snapshot};
@@ -48,6 +49,8 @@ pub struct Params {
     pub setup_advances_history: bool,
     /// Called once a step after the meeting, on thread 0; `None` for a normal run.
     pub meet: Option<MeetHook>,
+    /// Limits of the run guard.
+    pub guard: GuardLimits,
 }
 
 /// What the step keeps between steps besides the state: the pair list's builder and plan, the
@@ -68,6 +71,9 @@ pub struct Core<H> {
     pub pairs: Pairs<H>,
     pub params: Params,
     pub counters: StageTimes,
+    /// Why the run guard stopped the last run, if it did; the state is then not to be trusted
+    /// and no further step is taken.
+    pub failure: Option<Failure>,
     pub(super) work: Workspace,
 }
 
@@ -113,8 +119,10 @@ impl<H: History> Core<H> {
                 bind: true,
                 setup_advances_history: true,
                 meet: None,
+                guard: GuardLimits::default(),
             },
             counters: StageTimes::default(),
+            failure: None,
             work: Workspace {
                 moved_bound: [0.0; 2],
                 builder,

@@ -4,6 +4,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::arrays::Arrays;
+use super::guard::Breach;
 use crate::contact::{ContactLaw, PairInput};
 use crate::neighbor::rebuild::CLASSES;
 use crate::state::{Domain, PairForce};
@@ -21,6 +22,8 @@ pub(super) struct PairView<'a, L> {
     pub w: SharedSlice<Vec3>,
     pub radius: &'a [f64],
     pub inv_mass: &'a [f64],
+    /// Largest overlap allowed, as a fraction of the smaller radius (the run guard).
+    pub overlap: f64,
 }
 
 /// A range of pairs and their slots.
@@ -37,7 +40,8 @@ pub(super) struct PairSlots<'a, H> {
 /// [`crate::neighbor::rebuild::gap_closed`]), then the live prefix of each class is visited. A
 /// pair beyond reach cannot touch yet; its slot stays inactive, exactly as a full pass would
 /// leave it. The first `CLASSES / 2` classes hold interior pairs, whose direct separation is
-/// their minimum image. One call per chunk rather than per class: fewer loop starts.
+/// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns
+/// the first overlap beyond the guard's limit, if any.
 ///
 /// # Safety
 /// `arr` is valid; chunk `c` is taken by this thread alone; no thread writes the particles of
@@ -49,7 +53,8 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
     touched: &[AtomicBool],
     c: usize,
     closed: [f64; 3],
-) {
+) -> Option<Breach> {
+    let mut breach = None;
     let seg = arr.pair_ranges.get(c);
     let ends = arr.live.at_mut(c);
     let gap = arr.gap.slice(0..arr.gap.len());
@@ -71,16 +76,19 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
             active: arr.active.slice_mut(a..b),
             out: arr.out.slice_mut(a..b),
         };
-        if class < CLASSES / 2 {
-            pair_range::<L, false>(view, touched, slots);
+        let found = if class < CLASSES / 2 {
+            pair_range::<L, false>(view, touched, slots)
         } else {
-            pair_range::<L, true>(view, touched, slots);
-        }
+            pair_range::<L, true>(view, touched, slots)
+        };
+        breach = breach.or(found);
     }
+    breach
 }
 
 /// Forces of a range of pairs into their slots; sets the `touched` flag of the free particles
-/// of every contact. `PERIODIC` false for interior pairs.
+/// of every contact. `PERIODIC` false for interior pairs. Returns the first overlap beyond the
+/// guard's limit, if any.
 ///
 /// # Safety
 /// As [`pair_force`] for every pair of the range.
@@ -89,11 +97,14 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
     s: PairSlots<'_, L::History>,
-) {
+) -> Option<Breach> {
+    let mut breach = None;
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
-        pair_force::<L, PERIODIC>(view, p, i, history, active, out);
+        if let Some((delta, limit)) = pair_force::<L, PERIODIC>(view, p, i, history, active, out) {
+            breach.get_or_insert(Breach::Overlap { p, i, delta, limit });
+        }
         if s.active[k] {
             // only free particles gather (and clear their flag)
             for q in [p, i] {
@@ -103,9 +114,11 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
             }
         }
     }
+    breach
 }
 
-/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
+/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history. Returns
+/// the overlap and its limit (length) when the overlap exceeds the guard's limit.
 ///
 /// # Safety
 /// `p` and `i` index the views, and no thread writes their positions or velocities during the
@@ -118,7 +131,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     history: &mut L::History,
     active: &mut bool,
     out: &mut PairForce,
-) {
+) -> Option<(f64, f64)> {
     let direct = view.x.get(p) - view.x.get(i);
     let r = if PERIODIC {
         view.domain.min_image(direct)
@@ -131,7 +144,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
             *active = false;
             *history = L::History::default();
         }
-        return;
+        return None;
     }
     let input = PairInput {
         r,
@@ -142,8 +155,9 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         w_p: view.w.get(p),
         w_i: view.w.get(i),
     };
-    if let Some(kin) = input.kinematics() {
-        *out = view.law.evaluate(&kin, history, view.dt);
-        *active = true;
-    }
+    let kin = input.kinematics()?;
+    *out = view.law.evaluate(&kin, history, view.dt);
+    *active = true;
+    let limit = view.overlap * input.rad_p.min(input.rad_i);
+    (kin.delta > limit).then_some((kin.delta, limit))
 }

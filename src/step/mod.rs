@@ -27,6 +27,7 @@ mod arrays;
 pub mod core;
 pub mod counters;
 mod forces;
+pub mod guard;
 mod integrate;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -35,6 +36,7 @@ use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
 use self::forces::{pair_chunk, pair_force, PairView};
+use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState};
@@ -74,8 +76,10 @@ pub trait Engine: Send {
     fn contact_count(&self) -> usize;
     /// Number of candidate pairs at the last build.
     fn pair_count(&self) -> usize;
-    /// Advances `steps` time steps (evaluating the initial forces first if needed).
-    fn advance(&mut self, steps: u64);
+    /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
+    /// with the reason, when the run guard finds a number that cannot be trusted; after that
+    /// every call fails the same way.
+    fn advance(&mut self, steps: u64) -> Result<(), Failure>;
 }
 
 impl<L: ContactLaw> Engine for Simulation<L> {
@@ -112,16 +116,19 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     fn pair_count(&self) -> usize {
         self.core.pair_count()
     }
-    fn advance(&mut self, steps: u64) {
-        if !self.core.state.forces_ready {
+    fn advance(&mut self, steps: u64) -> Result<(), Failure> {
+        if self.core.failure.is_none() && !self.core.state.forces_ready {
             self.initial_forces();
         }
-        match (L::TANGENTIAL, self.core.params.gravity.is_some()) {
-            (true, false) => self.run::<true, false>(steps),
-            (true, true) => self.run::<true, true>(steps),
-            (false, false) => self.run::<false, false>(steps),
-            (false, true) => self.run::<false, true>(steps),
+        if self.core.failure.is_none() {
+            match (L::TANGENTIAL, self.core.params.gravity.is_some()) {
+                (true, false) => self.run::<true, false>(steps),
+                (true, true) => self.run::<true, true>(steps),
+                (false, false) => self.run::<false, false>(steps),
+                (false, true) => self.run::<false, true>(steps),
+            }
         }
+        self.core.failure.clone().map_or(Ok(()), Err)
     }
 }
 
@@ -131,9 +138,15 @@ impl<L: ContactLaw> Simulation<L> {
         Simulation { law, core }
     }
 
-    /// MercuryDPM evaluates the forces once before the first step, at x_0 with v_0.
+    /// MercuryDPM evaluates the forces once before the first step, at x_0 with v_0. The run
+    /// guard checks the positions first.
     fn initial_forces(&mut self) {
         self.core.rebuild();
+        let state = &self.core.state;
+        if let Some(b) = guard::outside(&state.particles, &state.domain) {
+            self.core.failure = Some(b.report(state.step, state.time, &state.id));
+            return;
+        }
         let params = &self.core.params;
         let dt = if params.setup_advances_history {
             params.dt
@@ -154,12 +167,19 @@ impl<L: ContactLaw> Simulation<L> {
                 w: arr.w,
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
+                overlap: self.core.params.guard.overlap,
             };
             for k in 0..arr.p.len() {
                 let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
                 let history = arr.history.at_mut(k);
                 let (active, out) = (arr.active.at_mut(k), arr.out.at_mut(k));
-                pair_force::<L, true>(&view, p, i, history, active, out);
+                if let Some((delta, limit)) =
+                    pair_force::<L, true>(&view, p, i, history, active, out)
+                {
+                    let breach = guard::Breach::Overlap { p, i, delta, limit };
+                    let state = &self.core.state;
+                    self.core.failure = Some(breach.report(state.step, state.time, &state.id));
+                }
             }
             for a in 0..n {
                 let (f, t) = gather(a, &arr);
@@ -186,6 +206,7 @@ impl<L: ContactLaw> Simulation<L> {
         let domain = core.state.domain.clone();
         let params = &core.params;
         let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
+        let overlap = params.guard.overlap;
         let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
         let mut list = core.list_state();
         let arrays = Shared::new(Arrays::of(&mut list));
@@ -204,6 +225,8 @@ impl<L: ContactLaw> Simulation<L> {
             arrays,
             meet,
             law: &self.law,
+            overlap,
+            alarm: Alarm::default(),
             kick: Kick {
                 domain: &domain,
                 dt,
@@ -212,7 +235,7 @@ impl<L: ContactLaw> Simulation<L> {
             skin,
         };
         let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
-        let (local, bound) = if threads == 1 {
+        let (local, bound, done) = if threads == 1 {
             work_of(0)
         } else {
             std::thread::scope(|s| {
@@ -223,15 +246,20 @@ impl<L: ContactLaw> Simulation<L> {
                 work_of(0)
             })
         };
-        drop(team);
+        let breach = team.alarm.take();
         let core = &mut self.core;
         core.counters.add_times(&local);
         core.counters.rebuilds += local.rebuilds;
         core.work.moved_bound = bound;
-        for _ in 0..steps {
+        for _ in 0..done {
             core.state.time += dt;
         }
-        core.state.step += steps;
+        core.state.step += done;
+        if let Some((_, b)) = breach {
+            let state = &mut core.state;
+            core.failure = Some(b.report(state.step, state.time, &state.id));
+            state.forces_ready = false;
+        }
     }
 }
 
@@ -252,6 +280,10 @@ struct Team<'a, L: ContactLaw> {
     arrays: Shared<Arrays<L::History>>,
     meet: Option<MeetHook>,
     law: &'a L,
+    /// Largest overlap allowed, as a fraction of the smaller radius.
+    overlap: f64,
+    /// The first breach of the run guard's limits.
+    alarm: Alarm,
     kick: Kick<'a>,
     skin: f64,
 }
@@ -281,34 +313,40 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         }
     }
 
-    /// The step loop of this thread, as named stages; returns its counters and the displacement
-    /// bounds at the end.
-    fn run<const ROT: bool, const GRAV: bool>(mut self, steps: u64) -> (StageTimes, [f64; 2]) {
+    /// The step loop of this thread, as named stages; returns its counters, the displacement
+    /// bounds at the end and the steps completed (fewer than `steps` when the run guard stops
+    /// the run: every thread stops at the same meeting).
+    fn run<const ROT: bool, const GRAV: bool>(mut self, steps: u64) -> (StageTimes, [f64; 2], u64) {
         let _bound = if self.team.bind {
             Bound::to_nth_cpu(self.tid, self.team.threads)
         } else {
             None
         };
         for s in 0..steps {
-            let speeds = self.kick_and_drift::<ROT, GRAV>((s > 0).then_some(s), true);
+            let speeds = self.kick_and_drift::<ROT, GRAV>(s, (s > 0).then_some(s), true);
             self.publish_speeds(s, speeds);
             self.meet();
+            if self.team.alarm.raised() {
+                return (self.times, self.bound, s);
+            }
             self.refill_queues(s);
             if self.skin_used_up(s) {
-                self.rebuild();
+                self.rebuild(s);
             }
             self.pair_forces(s);
         }
-        self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
-        (self.times, self.bound)
+        self.kick_and_drift::<ROT, GRAV>(steps, Some(steps), false);
+        (self.times, self.bound, steps)
     }
 
     /// Particle pass over the chunks this thread takes: the closing kick of step `gather` (none
     /// on the first step of a run), once every pair chunk with a pair of the chunk's particles is
     /// done, then, with `drift`, the opening kick and drift of the next. Returns the largest
-    /// squared speeds of slow [0] and fast [1] particles.
+    /// squared speeds of slow [0] and fast [1] particles. A velocity that is not finite raises
+    /// the alarm for run-local step `s`.
     fn kick_and_drift<const ROT: bool, const GRAV: bool>(
         &mut self,
+        s: u64,
         gather: Option<u64>,
         drift: bool,
     ) -> [f64; 2] {
@@ -318,7 +356,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         while let Some(c) = team.particle_queue.next(self.tid) {
             // SAFETY: a chunk is taken by one thread; its pairs' chunks are done (the wait below)
             // before it gathers; the views are current (see `Worker::rebuild`).
-            let seen = unsafe {
+            let (seen, breach) = unsafe {
                 let (a, b) = self.arr.particle_chunks.get(c);
                 if let (Some(round), true) = (gather, team.threads > 1) {
                     let (first, end) = self.arr.needs.get(c);
@@ -334,8 +372,11 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                     drift,
                 )
             };
-            for (m, s) in v2.iter_mut().zip(seen) {
-                *m = m.max(s);
+            if let Some(b) = breach {
+                team.alarm.raise(s, b);
+            }
+            for (m, x) in v2.iter_mut().zip(seen) {
+                *m = m.max(x);
             }
         }
         self.laps.lap(&mut self.times.integrate);
@@ -386,8 +427,9 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         gap_closed(self.bound).into_iter().fold(0.0, f64::max) > self.team.skin
     }
 
-    /// The team rebuilds the pair list between two barriers; thread 0 then retakes the views.
-    fn rebuild(&mut self) {
+    /// The team rebuilds the pair list between two barriers; thread 0 then retakes the views and
+    /// checks every position (the run guard; a breach stops the run at the next meeting).
+    fn rebuild(&mut self, s: u64) {
         let team = self.team;
         self.bound = [0.0; 2];
         team.barrier.wait();
@@ -400,7 +442,12 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         unsafe { rebuild::rebuild(crew, &team.list, team.kick.domain) };
         if self.tid == 0 {
             // SAFETY: the other threads wait at the barrier below and read the views after it.
-            unsafe { *team.arrays.exclusive() = Arrays::of(team.list.exclusive()) };
+            let l = unsafe { team.list.exclusive() };
+            if let Some(b) = guard::outside(l.particles, team.kick.domain) {
+                team.alarm.raise(s, b);
+            }
+            // SAFETY: as above.
+            unsafe { *team.arrays.exclusive() = Arrays::of(l) };
             self.times.rebuilds += 1;
         }
         team.barrier.wait();
@@ -430,10 +477,13 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                 w: arr.w,
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
+                overlap: team.overlap,
             };
             let touched = arr.touched.slice(0..n);
             while let Some(c) = team.pair_queue.next(self.tid) {
-                pair_chunk(&view, arr, touched, c, closed);
+                if let Some(b) = pair_chunk(&view, arr, touched, c, closed) {
+                    team.alarm.raise(s, b);
+                }
                 team.pairs_done.set(c, s + 1);
             }
         }
@@ -474,7 +524,7 @@ mod tests {
                 1,
             );
             let mut sim = Simulation::new(law, core);
-            super::Engine::advance(&mut sim, self.steps);
+            super::Engine::advance(&mut sim, self.steps).unwrap();
             let (c, steps) = (&sim.core, self.steps);
             assert!(c.counters.rebuilds >= 2, "no rebuild inside the run");
             let closed = super::gap_closed(c.work.moved_bound);

@@ -72,7 +72,7 @@ pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Out
     let reach = e.state().particles.radius[0] + e.state().particles.radius[1];
     let (mut started, mut steps_in_contact, mut delta_max) = (false, 0u64, 0.0f64);
     for _ in 0..100_000 {
-        e.advance(1);
+        e.advance(1)?;
         let s = e.snapshot();
         let d = reach - (s.particles.x[1] - s.particles.x[0]).norm();
         if !s.contacts.is_empty() {

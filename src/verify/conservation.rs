@@ -59,7 +59,7 @@ pub struct GasRun {
 pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
     let sc = scene::build(case, None)?;
     let mut e = engine::build(case, sc, &Overrides::default());
-    e.advance(0);
+    e.advance(0)?;
     let first = e.snapshot();
     let (e0, p0, _) = totals(&first, case.contact.kn);
     let mass: f64 = first.particles.inv_mass.iter().map(|im| 1.0 / im).sum();
@@ -69,7 +69,7 @@ pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
     let mut done = 0;
     while done < steps {
         let n = every.min(steps - done);
-        e.advance(n);
+        e.advance(n)?;
         done += n;
         let (en, p, _) = totals(&e.snapshot(), case.contact.kn);
         let rel = (en - e0) / e0;
@@ -114,9 +114,9 @@ pub fn cluster(case: &Case) -> Scene {
 }
 
 /// Relative change of the cluster's angular momentum over `steps` steps of `case`'s law.
-pub fn cluster_angular_momentum(case: &Case, steps: u64) -> f64 {
+pub fn cluster_angular_momentum(case: &Case, steps: u64) -> anyhow::Result<f64> {
     let mut e = engine::build(case, cluster(case), &Overrides::default());
-    e.advance(0);
+    e.advance(0)?;
     let first = e.snapshot();
     let (_, _, l0) = totals(&first, case.contact.kn);
     let p = &first.particles;
@@ -126,9 +126,9 @@ pub fn cluster_angular_momentum(case: &Case, steps: u64) -> f64 {
             p.x[a].cross(&(m * p.v[a])).norm() + inertia * p.w[a].norm()
         })
         .sum();
-    e.advance(steps);
+    e.advance(steps)?;
     let (_, _, l1) = totals(&e.snapshot(), case.contact.kn);
-    (l1 - l0).norm() / scale
+    Ok((l1 - l0).norm() / scale)
 }
 
 /// The conservation rows: the gas frictionless and elastic over `steps` steps, the gas with
@@ -165,7 +165,7 @@ pub fn rows(base: &Case, steps: u64) -> anyhow::Result<Vec<Row>> {
     for conv in Tangential::ALL {
         let mut case = base.clone();
         case.contact.tangential = conv;
-        let dl = cluster_angular_momentum(&case, 2000);
+        let dl = cluster_angular_momentum(&case, 2000)?;
         let r = row_abs(
             &format!("conservation cluster {} 2000 steps", conv.name()),
             "|L - L0| / sum |L_i|",

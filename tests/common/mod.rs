@@ -50,7 +50,7 @@ pub fn engine(case: &Case, init: Option<&Path>, o: Overrides) -> Box<dyn Engine>
 
 /// State hash after `steps` steps.
 pub fn hash_after(engine: &mut dyn Engine, steps: u64) -> String {
-    engine.advance(steps);
+    engine.advance(steps).unwrap();
     verdem::io::hash::state_hash(&engine.snapshot())
 }
 

@@ -1,0 +1,194 @@
+//! The run guard: checks a step makes at almost no cost, which stop a run whose numbers can no
+//! longer be trusted, naming the step, the particles, the quantity, its value and the limit.
+//!
+//! - every free particle's velocity and angular velocity after its kick is finite (checked in
+//!   the particle pass, beside the speed it computes anyway);
+//! - no overlap exceeds a fraction of the smaller radius (checked in the pair pass for the
+//!   pairs in contact only);
+//! - no free particle is outside the box along a walled axis or has a non-finite position
+//!   (checked at every pair-list rebuild, which visits every particle anyway: a particle moves
+//!   less than a skin between two rebuilds).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+
+/// Limits of the run guard.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuardLimits {
+    /// Largest overlap allowed, as a fraction of the smaller radius of the pair.
+    pub overlap: f64,
+}
+
+impl Default for GuardLimits {
+    fn default() -> Self {
+        GuardLimits {
+            overlap: crate::case::DEFAULT_GUARD_OVERLAP,
+        }
+    }
+}
+
+/// What went wrong, in memory indices (translated to ids when reported).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Breach {
+    /// A velocity (`angular` false) or angular velocity that is not finite.
+    NotFinite { particle: usize, angular: bool },
+    /// An overlap `delta` (length) beyond the limit between particles `p` and `i`.
+    Overlap {
+        p: usize,
+        i: usize,
+        delta: f64,
+        limit: f64,
+    },
+    /// A position outside the box along walled axis `axis` (0, 1, 2), or not finite.
+    Outside {
+        particle: usize,
+        axis: usize,
+        x: f64,
+    },
+}
+
+/// The first breach any thread saw in a run; the threads stop at their next meeting.
+#[derive(Default)]
+pub(super) struct Alarm {
+    raised: AtomicBool,
+    first: Mutex<Option<(u64, Breach)>>,
+}
+
+impl Alarm {
+    /// Records `breach`, seen at run-local step `s`, unless one was recorded before.
+    #[cold]
+    pub fn raise(&self, s: u64, breach: Breach) {
+        let mut first = self.first.lock().unwrap_or_else(|e| e.into_inner());
+        first.get_or_insert((s, breach));
+        self.raised.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether a breach was recorded (read after a barrier, every thread sees the same).
+    pub fn raised(&self) -> bool {
+        self.raised.load(Ordering::Relaxed)
+    }
+
+    /// The first breach and the run-local step it was seen at.
+    pub fn take(self) -> Option<(u64, Breach)> {
+        self.first.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// A run stopped by the guard: the step and time of the stop and what was found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Failure {
+    /// The step being computed when the breach was found.
+    pub step: u64,
+    /// Its time (time units).
+    pub time: f64,
+    /// Ids (1-based, as in the input files) of the particles involved.
+    pub ids: Vec<u32>,
+    /// The quantity, its value and the limit, in words.
+    pub what: String,
+    /// The likely cause and what to do about it.
+    pub remedy: &'static str,
+    /// What the run had written that stays on disk, when a run loop reports it.
+    pub kept: Option<String>,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ids: Vec<String> = self.ids.iter().map(u32::to_string).collect();
+        write!(
+            f,
+            "the run guard stopped the run at step {} (t = {}): particle {}: {}; {}",
+            self.step,
+            self.time,
+            ids.join(" and "),
+            self.what,
+            self.remedy
+        )?;
+        if let Some(kept) = &self.kept {
+            write!(f, "; {kept}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Failure {}
+
+const UNSTABLE: &str = "the explicit scheme is likely unstable: a smaller time step \
+    (run.steps_per_collision), a softer contact or less damping";
+
+impl Breach {
+    /// The failure report of this breach at `step` and `time`, with `id` the original index of
+    /// each memory index.
+    pub fn report(self, step: u64, time: f64, id: &[u32]) -> Failure {
+        let ids = |a: &[usize]| a.iter().map(|&m| id[m] + 1).collect::<Vec<u32>>();
+        let axis = |k: usize| ["x", "y", "z"][k];
+        match self {
+            Breach::NotFinite { particle, angular } => Failure {
+                step,
+                time,
+                ids: ids(&[particle]),
+                what: format!(
+                    "{} is not finite",
+                    if angular {
+                        "angular velocity"
+                    } else {
+                        "velocity"
+                    }
+                ),
+                remedy: "a force was not finite (coincident spheres, or an unstable step): \
+                    check the initial state for overlapping spheres, or use a smaller time step",
+                kept: None,
+            },
+            Breach::Overlap { p, i, delta, limit } => Failure {
+                step,
+                time,
+                ids: ids(&[p, i]),
+                what: format!(
+                    "overlap {delta:e} exceeds the limit {limit:e} (guard.overlap times the \
+                     smaller radius)"
+                ),
+                remedy: UNSTABLE,
+                kept: None,
+            },
+            Breach::Outside {
+                particle,
+                axis: k,
+                x,
+            } => Failure {
+                step,
+                time,
+                ids: ids(&[particle]),
+                what: format!(
+                    "position {} = {x} is outside the box or not finite",
+                    axis(k)
+                ),
+                remedy: UNSTABLE,
+                kept: None,
+            },
+        }
+    }
+}
+
+/// The first free particle (memory order) with a position that is not finite, or outside the
+/// box along a walled axis.
+pub(super) fn outside(
+    pt: &crate::state::Particles,
+    domain: &crate::state::Domain,
+) -> Option<Breach> {
+    (0..pt.len())
+        .filter(|&a| pt.inv_mass[a] > 0.0)
+        .find_map(|a| {
+            (0..3).find_map(|k| {
+                let x = pt.x[a][k];
+                let inside = if domain.periodic[k] {
+                    x.is_finite()
+                } else {
+                    x >= domain.lo[k] && x <= domain.hi[k]
+                };
+                (!inside).then_some(Breach::Outside {
+                    particle: a,
+                    axis: k,
+                    x,
+                })
+            })
+        })
+}
