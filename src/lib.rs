@@ -5,6 +5,7 @@
 //! read) → [`sim`] (the time step, top to bottom) → [`io`] (MercuryCG `.data`/`.fstat` saves,
 //! checkpoints) and [`diagnostics`].
 
+pub mod analysis;
 pub mod bench;
 pub mod case;
 pub mod cg;

@@ -2,7 +2,8 @@
 //! symmetry, steadiness across the blocks of saves, and a kinetic-theory sanity check
 //! (reported, never failed).
 
-use super::{columns, core_range, standard_error, Profiles, COLUMNS};
+use super::{columns, core_range, Profiles, COLUMNS};
+use crate::analysis::stats::{block, standard_error, trend, weighted_mean_chi2};
 
 /// One check: what was measured against what was expected, and whether it passed
 /// (`None`: reported only).
@@ -38,56 +39,6 @@ fn col(name: &str) -> usize {
         .expect("known column")
 }
 
-/// Reduced chi-square of values against their error-weighted mean.
-fn uniformity(v: &[f64], se: &[f64]) -> (f64, f64) {
-    let w: Vec<f64> = se.iter().map(|s| 1.0 / (s * s).max(1e-300)).collect();
-    let mean = v.iter().zip(&w).map(|(x, w)| x * w).sum::<f64>() / w.iter().sum::<f64>();
-    let chi2 = v
-        .iter()
-        .zip(se)
-        .map(|(x, s)| ((x - mean) / s.max(1e-300)).powi(2))
-        .sum::<f64>();
-    (mean, chi2 / (v.len() as f64 - 1.0).max(1.0))
-}
-
-/// Least-squares line through equally spaced values `y`: its change from the first to the last
-/// point relative to the mean, and its slope in units of the slope's standard error (from the
-/// residuals; ±∞ for an exact line, 0 for fewer than three points or constant values).
-fn trend(y: &[f64]) -> (f64, f64) {
-    let n = y.len() as f64;
-    if y.len() < 3 {
-        return (0.0, 0.0);
-    }
-    let x_mean = (n - 1.0) / 2.0;
-    let y_mean = y.iter().sum::<f64>() / n;
-    let sxx: f64 = (0..y.len()).map(|i| (i as f64 - x_mean).powi(2)).sum();
-    let slope = y
-        .iter()
-        .enumerate()
-        .map(|(i, v)| (i as f64 - x_mean) * (v - y_mean))
-        .sum::<f64>()
-        / sxx;
-    let residual: f64 = y
-        .iter()
-        .enumerate()
-        .map(|(i, v)| (v - y_mean - slope * (i as f64 - x_mean)).powi(2))
-        .sum();
-    let se = (residual / (n - 2.0) / sxx).sqrt();
-    let change = if y_mean != 0.0 {
-        slope * (n - 1.0) / y_mean
-    } else {
-        0.0
-    };
-    let t = if se > 0.0 {
-        slope / se
-    } else if slope == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY.copysign(slope)
-    };
-    (change, t)
-}
-
 /// Runs every check. `density` is the particle density (for the kinetic-theory check).
 pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     let core = core_range(&p.grid);
@@ -112,7 +63,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     // 1. Momentum balance: shear stress and σzz uniform across the core.
     let (tau_mean, tau_chi) = {
         let (v, se) = get("shear_xz");
-        uniformity(&v, &se)
+        weighted_mean_chi2(&v, &se)
     };
     out.push(Check {
         name: format!("shear stress uniform for z in [{z0:.2}, {z1:.2}]"),
@@ -128,7 +79,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         .clone()
         .map(|k| (p.se[k][col("kin_zz")].powi(2) + p.se[k][col("con_zz")].powi(2)).sqrt())
         .collect();
-    let (zz_mean, zz_chi) = uniformity(&zz, &zz_se);
+    let (zz_mean, zz_chi) = weighted_mean_chi2(&zz, &zz_se);
     out.push(Check {
         name: format!("sigma_zz uniform for z in [{z0:.2}, {z1:.2}]"),
         measured: format!("chi2/dof = {zz_chi:.2} (mean {zz_mean:.5})"),
@@ -143,8 +94,9 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         let n = p.wall_force.len();
         let vals: Vec<f64> = (0..blocks)
             .map(|b| {
-                let (s, e) = (b * n / blocks, (b + 1) * n / blocks);
-                (s..e).map(f).sum::<f64>() / (e - s) as f64
+                let saves = block(b, blocks, n);
+                let len = saves.len();
+                saves.map(f).sum::<f64>() / len as f64
             })
             .collect();
         (
@@ -325,7 +277,7 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{trend, unsteady_note, Check, STEADY};
+    use super::{unsteady_note, Check, STEADY};
 
     #[test]
     fn only_a_failed_steadiness_check_adds_the_note() {
@@ -345,23 +297,5 @@ mod tests {
             unsteady_note(&[check("sigma_zz uniform", Some(false))]),
             None
         );
-    }
-
-    #[test]
-    fn a_trend_is_measured_against_its_scatter() {
-        // exact line 10, 11, …, 14: a rise of 4 over a mean of 12, with no scatter
-        let (change, t) = trend(&[10.0, 11.0, 12.0, 13.0, 14.0]);
-        assert!((change - 4.0 / 12.0).abs() < 1e-12, "{change}");
-        assert_eq!(t, f64::INFINITY, "an exact line is a trend");
-        assert_eq!(trend(&[3.0; 5]), (0.0, 0.0));
-        // alternating scatter of ±1 around a flat line: no trend
-        let (change, t) = trend(&[1.0, -1.0, 1.0, -1.0, 1.0, -1.0].map(|v| 10.0 + v));
-        assert!(change.abs() < 0.15 && t.abs() < 1.0, "{change} {t}");
-        // a clear rise through scatter
-        let y: Vec<f64> = (0..10)
-            .map(|i| 10.0 + i as f64 + if i % 2 == 0 { 0.3 } else { -0.3 })
-            .collect();
-        let (_, t) = trend(&y);
-        assert!(t > 10.0, "{t}");
     }
 }

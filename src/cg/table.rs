@@ -1,6 +1,7 @@
 //! Profiles as a table of numbers: written as CSV, read back (golden peer profiles are stored
 //! this way), and compared slice by slice against their combined standard errors.
 
+use crate::analysis::stats::mean_chi2;
 use crate::io::{read_text, FormatError};
 
 use super::{columns, Grid, Profiles, COLUMNS};
@@ -130,18 +131,16 @@ pub fn chi2(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Res
         a.z.len(),
         b.z.len()
     );
-    let (mut sum, mut n) = (0.0, 0usize);
-    for k in 0..a.z.len() {
-        if a.z[k] < window.0 || a.z[k] > window.1 {
-            continue;
-        }
-        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
-        if var > 0.0 {
-            sum += (a.mean[k][col] - b.mean[k][col]).powi(2) / var;
-            n += 1;
-        }
-    }
-    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
+    Ok(mean_chi2(
+        (0..a.z.len())
+            .filter(|&k| !(a.z[k] < window.0 || a.z[k] > window.1))
+            .map(|k| {
+                (
+                    a.mean[k][col] - b.mean[k][col],
+                    a.se[k][col].powi(2) + b.se[k][col].powi(2),
+                )
+            }),
+    ))
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use std::path::Path;
 use anyhow::{ensure, Context};
 
 use super::{dump, input_script, run, Peer};
+use crate::analysis::stats::quantile;
 use crate::case::{Case, Tangential};
 use crate::cg::{self, table::Table};
 use crate::contact::PairForce;
@@ -42,16 +43,12 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(mut v: Vec<f64>) -> Spread {
-        if v.is_empty() {
-            return Spread::default();
-        }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+    /// The spread of `v` (nearest-rank quantiles; all 0 for no values).
+    fn of(v: &[f64]) -> Spread {
         Spread {
-            max: v[v.len() - 1],
-            median: at(0.5),
-            p99: at(0.99),
+            max: quantile(v, 1.0),
+            median: quantile(v, 0.5),
+            p99: quantile(v, 0.99),
         }
     }
 }
@@ -240,7 +237,7 @@ pub fn cross(
         atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
         let (a, b) = (&own.particles, &theirs.particles);
         let n = a.len();
-        let diff = |f: &dyn Fn(usize) -> f64| Spread::of((0..n).map(f).collect());
+        let diff = |f: &dyn Fn(usize) -> f64| Spread::of(&(0..n).map(f).collect::<Vec<_>>());
         saves.push(SaveDiff {
             step: k * every,
             dx: diff(&|i| own.domain.min_image(b.x[i] - a.x[i]).norm()),

@@ -102,18 +102,6 @@ pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Least-squares slope of (x, y) points.
-pub fn slope(p: &[(f64, f64)]) -> f64 {
-    let n = p.len() as f64;
-    let (mx, my) = (
-        p.iter().map(|q| q.0).sum::<f64>() / n,
-        p.iter().map(|q| q.1).sum::<f64>() / n,
-    );
-    let sxy: f64 = p.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
-    let sxx: f64 = p.iter().map(|q| (q.0 - mx).powi(2)).sum();
-    sxy / sxx
-}
-
 /// Rows that gate and failed.
 pub fn failures(rows: &[Row]) -> usize {
     rows.iter().filter(|r| r.gate && !r.pass).count()
