@@ -10,6 +10,7 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::analysis::stats::{hinges, median, median_interval};
+use crate::analysis::{Limit, Outcome, Verdict};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::peers::{self, Peer};
@@ -225,17 +226,35 @@ fn interval(found: Option<(f64, f64)>) -> String {
     }
 }
 
-/// Whether the median of the distribution the values `r` are drawn from reaches `goal`:
-/// "met" when all of its interval of the median does, "not met" when none does, "undecided" when it
-/// holds the goal or there are too few values for one; followed by the interval.
-fn verdict(r: &[f64], goal: f64) -> String {
+/// Whether the median of the distribution the ratios `r` are drawn from reaches `goal`:
+/// [`Outcome::Pass`] when all of its interval of the median does, [`Outcome::Fail`] when none
+/// does, [`Outcome::Undecided`] when it holds the goal or there are too few values for one. The
+/// measured value is the median (NaN for no values), the interval is its text; a goal does not
+/// gate.
+fn goal_verdict(quantity: &str, r: &[f64], goal: f64) -> Verdict {
     let found = median_interval(r, CONFIDENCE);
-    let word = match found {
-        Some((lo, _)) if lo >= goal => "met",
-        Some((_, hi)) if hi < goal => "not met",
-        _ => "undecided",
+    let outcome = match found {
+        Some((lo, _)) if lo >= goal => Outcome::Pass,
+        Some((_, hi)) if hi < goal => Outcome::Fail,
+        _ => Outcome::Undecided,
     };
-    format!("{word} ({})", interval(found))
+    let measured = if r.is_empty() { f64::NAN } else { median(r) };
+    Verdict {
+        outcome,
+        gate: false,
+        ..Verdict::judge("", quantity, measured, Limit::AtLeast(goal))
+    }
+    .described(interval(found), format!("≥ {goal}"))
+}
+
+/// A goal's verdict in words: "met", "not met" or "undecided", followed by the interval.
+fn in_words(v: &Verdict) -> String {
+    let word = match v.outcome {
+        Outcome::Pass => "met",
+        Outcome::Fail => "not met",
+        Outcome::Undecided | Outcome::Reported => "undecided",
+    };
+    format!("{word} ({})", v.measured_text)
 }
 
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
@@ -276,7 +295,11 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
         s.push_str(&format!(
             "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round; middle half of the rounds {lo:.2}–{hi:.2}; ≥ {SPEEDUP_GOAL} in {reached} of {} rounds; goal ≥ {SPEEDUP_GOAL}: {})",
             ratios.len(),
-            verdict(&ratios, SPEEDUP_GOAL)
+            in_words(&goal_verdict(
+                "verdem 2 threads / 1 thread",
+                &ratios,
+                SPEEDUP_GOAL
+            ))
         ));
         // A ceiling row against 1 thread alone, and verdem's 2 threads against the ceiling.
         let ceiling = |row: &Measured, runs: &str, gives: &str| {
@@ -318,11 +341,12 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             .filter(|x| matches!(x.config, Config::Peer { np: 2, .. }))
         {
             let ratios = paired_ratios(peer, two);
+            let quantity = format!("verdem 2 threads / {} 2 ranks", peer.config.label().0);
+            let verdict = goal_verdict(&quantity, &ratios, PEER_GOAL);
             s.push_str(&format!(
-                "\nverdem 2 threads / {} 2 ranks: {:.2} (median over the rounds of the ratio within a round); goal ≥ {PEER_GOAL}: {}\n",
-                peer.config.label().0,
-                median(&ratios),
-                verdict(&ratios, PEER_GOAL)
+                "\n{quantity}: {:.2} (median over the rounds of the ratio within a round); goal ≥ {PEER_GOAL}: {}\n",
+                verdict.measured,
+                in_words(&verdict)
             ));
         }
     }
@@ -413,7 +437,7 @@ mod tests {
 
     #[test]
     fn the_verdict_says_met_only_when_the_whole_interval_reaches_the_goal() {
-        let at = |v: &[f64]| verdict(v, 1.7);
+        let at = |v: &[f64]| in_words(&goal_verdict("2/1", v, 1.7));
         assert_eq!(
             at(&[1.8, 1.75, 1.9, 2.0, 1.71, 1.85]),
             "met (95 % interval of the median 1.710–2.000)"

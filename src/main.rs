@@ -612,7 +612,7 @@ fn real_main() -> anyhow::Result<Finished> {
                 }
             }
             print!("{}", verdem::verify::table(&rows));
-            let passed = rows.iter().filter(|r| r.pass).count();
+            let passed = rows.iter().filter(|r| r.passed()).count();
             let failed = verdem::verify::failures(&rows);
             println!(
                 "{passed} passed, {failed} failed, {} known defects of peer conventions (FAIL*)",

@@ -310,9 +310,9 @@ fn checks_against_error_bars_need_two_blocks() {
     assert_eq!(blocks, 1, "{report}");
     let symmetric = |c: &[cg::checks::Check]| {
         c.iter()
-            .find(|c| c.name == "symmetric nu about the mid-plane")
+            .find(|c| c.quantity == "symmetric nu about the mid-plane")
             .unwrap()
-            .pass
+            .pass()
     };
     assert_eq!(symmetric(&checks), None, "{report}");
     assert!(!report.contains("FAIL"), "{report}");

@@ -17,6 +17,7 @@ use anyhow::{ensure, Context};
 
 use super::{dump, input_script, run, Peer};
 use crate::analysis::stats::quantile;
+use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential};
 use crate::cg::{self, table::Table};
 use crate::contact::PairForce;
@@ -84,6 +85,17 @@ impl Report {
             .map(|s| s.step)
     }
 
+    /// The χ²/dof of each profile of [`cg::FIELDS`] against verdem's, as reported verdicts
+    /// (≈ 1 when the two differ by noise only; the quantity is the profile's name, the case
+    /// the peer's).
+    pub fn profile_verdicts(&self) -> Vec<Verdict> {
+        cg::FIELDS
+            .iter()
+            .zip(self.profiles_chi2)
+            .map(|((name, _), c)| Verdict::reported(self.peer.binary(), name, c, Limit::None))
+            .collect()
+    }
+
     /// The comparison as a markdown table with a summary line.
     pub fn markdown(&self) -> String {
         let mut s = format!(
@@ -107,10 +119,10 @@ impl Report {
             Some(step) => writeln!(s, "\nlargest |dx| first exceeds 1e-6 at step {step}"),
             None => writeln!(s, "\nlargest |dx| stays within 1e-6 up to step {last}"),
         };
-        let chi2: Vec<String> = cg::FIELDS
+        let chi2: Vec<String> = self
+            .profile_verdicts()
             .iter()
-            .zip(self.profiles_chi2)
-            .map(|((name, _), c)| format!("{name} {c:.2}"))
+            .map(|v| format!("{} {:.2}", v.quantity, v.measured))
             .collect();
         let _ = writeln!(
             s,
