@@ -325,3 +325,23 @@ fn checks_against_error_bars_need_two_blocks() {
     assert_eq!(symmetric(&checks), Some(false), "{report}");
     assert!(!report.contains("not judged"), "{report}");
 }
+
+/// Every profiles table kept in golden/ reads back and is written again byte for byte.
+#[test]
+fn golden_profiles_tables_round_trip_byte_for_byte() {
+    let mut tables = vec![common::root().join("golden/full_run/shear_flow.profiles.csv")];
+    for dir in ["golden/peers", "golden/tradeoff"] {
+        for entry in std::fs::read_dir(common::root().join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.to_string_lossy().ends_with(".profiles.csv") {
+                tables.push(path);
+            }
+        }
+    }
+    assert!(tables.len() >= 13, "{tables:?}");
+    for path in tables {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let table = verdem::cg::table::Table::read(&path).unwrap();
+        assert!(table.csv() == text, "{}", path.display());
+    }
+}

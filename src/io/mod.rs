@@ -2,6 +2,7 @@
 //! writes.
 
 pub mod atomic;
+pub mod csv_table;
 pub mod mercury;
 pub mod official;
 
