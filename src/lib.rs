@@ -8,7 +8,6 @@
 pub mod analysis;
 pub mod bench;
 pub mod case;
-pub mod cg;
 pub mod checkpoint;
 pub mod contact;
 pub mod diagnostics;
@@ -24,7 +23,6 @@ pub mod scene;
 pub mod sim;
 pub mod state;
 pub mod team;
-pub mod tradeoff;
 pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.

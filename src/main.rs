@@ -7,8 +7,8 @@ use std::sync::Arc;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
+use verdem::analysis::cg::{self, table::Table, CgOptions, KernelChoice};
 use verdem::case::Case;
-use verdem::cg::{self, table::Table, CgOptions, KernelChoice};
 use verdem::engine::{self, Overrides};
 use verdem::run::{self, RunOptions};
 use verdem::{bench, checkpoint, hash, scene};
@@ -662,8 +662,11 @@ fn real_main() -> anyhow::Result<Finished> {
                     .unwrap_or_else(|| p.display().to_string());
                 tables.push((label, Table::read(p)?));
             }
-            let rows = verdem::cg::compare::compare(&tables[0].1, &tables[1..])?;
-            print!("{}", verdem::cg::compare::markdown(&tables[0].0, &rows));
+            let rows = verdem::analysis::cg::compare::compare(&tables[0].1, &tables[1..])?;
+            print!(
+                "{}",
+                verdem::analysis::cg::compare::markdown(&tables[0].0, &rows)
+            );
             if let Some(png) = plot {
                 let runs: Vec<(&str, &Table)> =
                     tables.iter().map(|(l, t)| (l.as_str(), t)).collect();
@@ -681,8 +684,8 @@ fn real_main() -> anyhow::Result<Finished> {
         } => {
             let case = Case::load(&case)?;
             let pair = Case::load(&pair)?;
-            let outcomes = verdem::tradeoff::run(&case, &pair, &from, time, saves, &out)?;
-            let table = verdem::tradeoff::markdown(&outcomes);
+            let outcomes = verdem::analysis::tradeoff::run(&case, &pair, &from, time, saves, &out)?;
+            let table = verdem::analysis::tradeoff::markdown(&outcomes);
             verdem::io::atomic::write(&out.join("tradeoff.md"), table.as_bytes())?;
             print!("{table}");
         }

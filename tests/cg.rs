@@ -4,7 +4,7 @@ mod common;
 
 use std::path::Path;
 
-use verdem::cg::{self, CgOptions, KernelChoice, COLUMNS};
+use verdem::analysis::cg::{self, CgOptions, KernelChoice, COLUMNS};
 use verdem::io::mercury;
 
 const AREA: f64 = 4.0 * 5.0;
@@ -341,7 +341,7 @@ fn golden_profiles_tables_round_trip_byte_for_byte() {
     assert!(tables.len() >= 13, "{tables:?}");
     for path in tables {
         let text = std::fs::read_to_string(&path).unwrap();
-        let table = verdem::cg::table::Table::read(&path).unwrap();
+        let table = verdem::analysis::cg::table::Table::read(&path).unwrap();
         assert!(table.csv() == text, "{}", path.display());
     }
 }

@@ -16,10 +16,10 @@ use std::path::Path;
 use anyhow::{ensure, Context};
 
 use super::{dump, input_script, run, Peer};
+use crate::analysis::cg::{self, table::Table};
 use crate::analysis::stats::quantile;
 use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential};
-use crate::cg::{self, table::Table};
 use crate::contact::PairForce;
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
