@@ -8,9 +8,9 @@ use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use verdem::analysis::cg::fields::{raw_fields, Grid};
+use verdem::analysis::cg::kernel::Kernel;
 use verdem::case::Case;
-use verdem::cg::fields::{raw_fields, Grid};
-use verdem::cg::kernel::Kernel;
 use verdem::contact::{
     ContactLaw, Frictionless, FrictionlessLaw, LinearSpringDashpot, MercuryLaw,
     MercurySlidingFriction, PairInput,

@@ -9,6 +9,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 
+use crate::analysis::stats::{hinges, median, median_interval};
+use crate::analysis::{Limit, Outcome, Verdict};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::peers::Peer;
@@ -81,17 +83,7 @@ pub struct Measured {
 impl Measured {
     /// Median steps per second.
     pub fn median(&self) -> f64 {
-        median(self.rates.clone())
-    }
-}
-
-fn median(mut r: Vec<f64>) -> f64 {
-    r.sort_by(f64::total_cmp);
-    let n = r.len();
-    if n % 2 == 1 {
-        r[n / 2]
-    } else {
-        0.5 * (r[n / 2 - 1] + r[n / 2])
+        median(&self.rates)
     }
 }
 
@@ -226,55 +218,16 @@ fn paired_ratios(a: &Measured, b: &Measured) -> Vec<f64> {
     a.rates.iter().zip(&b.rates).map(|(x, y)| y / x).collect()
 }
 
-/// Tukey's hinges of `r` (the medians of its lower and upper halves, each with the middle
-/// value when their count is odd): the spread of the middle half of the rounds.
-fn hinges(mut r: Vec<f64>) -> (f64, f64) {
-    r.sort_by(f64::total_cmp);
-    let half = r.len().div_ceil(2);
-    (
-        median(r[..half].to_vec()),
-        median(r[r.len() - half..].to_vec()),
-    )
-}
-
 /// The speed-up of 2 threads over 1 asked of verdem; the table counts the rounds that reach it.
 const SPEEDUP_GOAL: f64 = 1.7;
 
 /// The rate on 2 threads asked of verdem, in multiples of a peer's rate on 2 ranks.
 const PEER_GOAL: f64 = 5.0;
 
-/// The confidence of the interval [`median_interval`] gives.
+/// The confidence of the intervals of the median.
 const CONFIDENCE: f64 = 0.95;
 
-/// A distribution-free interval for the median of the distribution `r` is drawn from, taking
-/// its values as independent: the k-th smallest and the k-th largest value, with the largest k
-/// for which the interval covers the median with probability ≥ [`CONFIDENCE`] (it misses only
-/// when k or more values fall on one side of the median, each with probability ½: a binomial
-/// tail; Conover, *Practical Nonparametric Statistics*, 3rd ed., §3.2). `None` with fewer than
-/// six values, which no such interval reaches.
-fn median_interval(mut r: Vec<f64>) -> Option<(f64, f64)> {
-    r.sort_by(f64::total_cmp);
-    let n = r.len();
-    // P(at most j of n values below the median) for j = 0, 1, …, summed in log space so that
-    // 2⁻ⁿ does not underflow for long runs.
-    let ln_half_n = -(n as f64) * std::f64::consts::LN_2;
-    let mut ln_term = ln_half_n;
-    let mut tail = 0.0;
-    let mut k = 0;
-    for j in 0..n.div_ceil(2) {
-        if j > 0 {
-            ln_term += ((n - j + 1) as f64 / j as f64).ln();
-        }
-        tail += ln_term.exp();
-        if 2.0 * tail > 1.0 - CONFIDENCE {
-            break;
-        }
-        k = j + 1;
-    }
-    (k > 0).then(|| (r[k - 1], r[n - k]))
-}
-
-/// An interval from [`median_interval`], in words.
+/// An interval of the median, in words.
 fn interval(found: Option<(f64, f64)>) -> String {
     let pct = 100.0 * CONFIDENCE;
     match found {
@@ -283,17 +236,35 @@ fn interval(found: Option<(f64, f64)>) -> String {
     }
 }
 
-/// Whether the median of the distribution the values `r` are drawn from reaches `goal`:
-/// "met" when all of [`median_interval`] does, "not met" when none does, "undecided" when it
-/// holds the goal or there are too few values for one; followed by the interval.
-fn verdict(r: &[f64], goal: f64) -> String {
-    let found = median_interval(r.to_vec());
-    let word = match found {
-        Some((lo, _)) if lo >= goal => "met",
-        Some((_, hi)) if hi < goal => "not met",
-        _ => "undecided",
+/// Whether the median of the distribution the ratios `r` are drawn from reaches `goal`:
+/// [`Outcome::Pass`] when all of its interval of the median does, [`Outcome::Fail`] when none
+/// does, [`Outcome::Undecided`] when it holds the goal or there are too few values for one. The
+/// measured value is the median (NaN for no values), the interval is its text; a goal does not
+/// gate.
+fn goal_verdict(quantity: &str, r: &[f64], goal: f64) -> Verdict {
+    let found = median_interval(r, CONFIDENCE);
+    let outcome = match found {
+        Some((lo, _)) if lo >= goal => Outcome::Pass,
+        Some((_, hi)) if hi < goal => Outcome::Fail,
+        _ => Outcome::Undecided,
     };
-    format!("{word} ({})", interval(found))
+    let measured = if r.is_empty() { f64::NAN } else { median(r) };
+    Verdict {
+        outcome,
+        gate: false,
+        ..Verdict::judge("", quantity, measured, Limit::AtLeast(goal))
+    }
+    .described(interval(found), format!("≥ {goal}"))
+}
+
+/// A goal's verdict in words: "met", "not met" or "undecided", followed by the interval.
+fn in_words(v: &Verdict) -> String {
+    let word = match v.outcome {
+        Outcome::Pass => "met",
+        Outcome::Fail => "not met",
+        Outcome::Undecided | Outcome::Reported => "undecided",
+    };
+    format!("{word} ({})", v.measured_text)
 }
 
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
@@ -328,21 +299,25 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
     };
     if let (Some(one), Some(two)) = (find(1, 1, false), find(2, 1, false)) {
         let ratios = paired_ratios(one, two);
-        let speedup = median(ratios.clone());
-        let (lo, hi) = hinges(ratios.clone());
+        let speedup = median(&ratios);
+        let (lo, hi) = hinges(&ratios);
         let reached = ratios.iter().filter(|&&r| r >= SPEEDUP_GOAL).count();
         s.push_str(&format!(
             "\nverdem 2 threads / 1 thread: {speedup:.2} (median over the rounds of the ratio within a round; middle half of the rounds {lo:.2}–{hi:.2}; ≥ {SPEEDUP_GOAL} in {reached} of {} rounds; goal ≥ {SPEEDUP_GOAL}: {})",
             ratios.len(),
-            verdict(&ratios, SPEEDUP_GOAL)
+            in_words(&goal_verdict(
+                "verdem 2 threads / 1 thread",
+                &ratios,
+                SPEEDUP_GOAL
+            ))
         ));
         // A ceiling row against 1 thread alone, and verdem's 2 threads against the ceiling.
         let ceiling = |row: &Measured, runs: &str, gives: &str| {
             let ratios = paired_ratios(one, row);
-            let ceiling = median(ratios.clone());
+            let ceiling = median(&ratios);
             format!(
                 "; {runs} / 1 run alone: {ceiling:.2} ({}), what this machine gives {gives}; verdem's 2 threads reach {:.0} % of that",
-                interval(median_interval(ratios)),
+                interval(median_interval(&ratios, CONFIDENCE)),
                 100.0 * speedup / ceiling
             )
         };
@@ -354,10 +329,10 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             ));
             let cpus: Vec<f64> = pair.copy_rates.iter().map(|r| r[1] / r[0]).collect();
             if !cpus.is_empty() {
-                let (lo, hi) = hinges(cpus.clone());
+                let (lo, hi) = hinges(&cpus);
                 s.push_str(&format!(
                     " (the run on CPU 1 ran at {:.2}× the rate of the run on CPU 0, middle half of the rounds {lo:.2}–{hi:.2}: a fixed half of the work each would run at the slower one's pace)",
-                    median(cpus)
+                    median(&cpus)
                 ));
             }
         }
@@ -376,11 +351,12 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             .filter(|x| matches!(x.config, Config::Peer { np: 2, .. }))
         {
             let ratios = paired_ratios(peer, two);
+            let quantity = format!("verdem 2 threads / {} 2 ranks", peer.config.label().0);
+            let verdict = goal_verdict(&quantity, &ratios, PEER_GOAL);
             s.push_str(&format!(
-                "\nverdem 2 threads / {} 2 ranks: {:.2} (median over the rounds of the ratio within a round); goal ≥ {PEER_GOAL}: {}\n",
-                peer.config.label().0,
-                median(ratios.clone()),
-                verdict(&ratios, PEER_GOAL)
+                "\n{quantity}: {:.2} (median over the rounds of the ratio within a round); goal ≥ {PEER_GOAL}: {}\n",
+                verdict.measured,
+                in_words(&verdict)
             ));
         }
     }
@@ -407,31 +383,33 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
     s
 }
 
-/// The table as CSV.
+/// The table as CSV: code, processes/threads, median steps/s, particle-steps/s, the rounds'
+/// steps/s separated by spaces; fields quoted (RFC 4180) when they hold a comma, a quote or a
+/// line break.
 pub fn csv(m: &[Measured], particles: usize) -> String {
-    let mut s = String::from("code,procs,median_steps_per_s,particle_steps_per_s,rounds\n");
+    let mut w = ::csv::Writer::from_writer(Vec::new());
+    let fail = "a CSV table is written to memory";
+    w.write_record([
+        "code",
+        "procs",
+        "median_steps_per_s",
+        "particle_steps_per_s",
+        "rounds",
+    ])
+    .expect(fail);
     for x in m {
         let (code, n) = x.config.label();
         let rounds: Vec<String> = x.rates.iter().map(|r| format!("{r:.1}")).collect();
-        s.push_str(&format!(
-            "{},{},{:.1},{:.1},{}\n",
-            csv_field(&code),
-            csv_field(&n),
-            x.median(),
-            x.median() * particles as f64,
-            rounds.join(" ")
-        ));
+        w.write_record([
+            code,
+            n,
+            format!("{:.1}", x.median()),
+            format!("{:.1}", x.median() * particles as f64),
+            rounds.join(" "),
+        ])
+        .expect(fail);
     }
-    s
-}
-
-/// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break.
-fn csv_field(v: &str) -> String {
-    if v.contains([',', '"', '\n']) {
-        format!("\"{}\"", v.replace('"', "\"\""))
-    } else {
-        v.to_string()
-    }
+    String::from_utf8(w.into_inner().expect(fail)).expect("CSV of UTF-8 fields")
 }
 
 /// The first lines of `bench.md`: what was timed (`steps` steps of `case` from the state file
@@ -462,13 +440,6 @@ pub fn cpu_model() -> String {
 mod tests {
     use super::*;
 
-    #[test]
-    fn csv_fields_with_commas_or_quotes_are_quoted() {
-        assert_eq!(csv_field("lammps"), "lammps");
-        assert_eq!(csv_field("a, b"), "\"a, b\"");
-        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
-    }
-
     fn measured(threads: usize, copies: usize, rates: &[f64]) -> Measured {
         Measured {
             config: Config::Verdem {
@@ -483,6 +454,22 @@ mod tests {
     }
 
     #[test]
+    fn the_csv_has_one_record_per_configuration() {
+        let mut peer = measured(1, 1, &[1.0, 3.0]);
+        peer.config = Config::Peer {
+            peer: crate::peers::by_name("lammps").unwrap(),
+            np: 2,
+        };
+        let m = [measured(1, 2, &[100.0, 110.05]), peer];
+        assert_eq!(
+            csv(&m, 10),
+            "code,procs,median_steps_per_s,particle_steps_per_s,rounds\n\
+             2 independent verdem runs at once (summed),2×1,105.0,1050.2,100.0 110.0\n\
+             lammps,2,2.0,20.0,1.0 3.0\n"
+        );
+    }
+
+    #[test]
     fn the_paired_ratio_is_the_median_of_the_ratios_within_rounds() {
         // ratios 3, 1, 0.5: median 1; the ratio of the medians would be 3/2
         let (a, b) = (
@@ -494,34 +481,8 @@ mod tests {
     }
 
     #[test]
-    fn hinges_are_the_medians_of_the_halves() {
-        assert_eq!(hinges(vec![5.0, 1.0, 3.0, 2.0, 4.0]), (2.0, 4.0));
-        assert_eq!(hinges(vec![4.0, 1.0, 3.0, 2.0]), (1.5, 3.5));
-        assert_eq!(hinges(vec![7.0]), (7.0, 7.0));
-    }
-
-    #[test]
-    fn the_median_interval_is_the_widest_order_statistics_the_binomial_tail_allows() {
-        let values = |n: usize| (1..=n).rev().map(|v| v as f64).collect::<Vec<f64>>();
-        assert_eq!(median_interval(values(5)), None);
-        // n = 6: P(0 below) = 1/64 per side, 3.1 % in all; P(≤ 1 below) = 7/64 is too much
-        assert_eq!(median_interval(values(6)), Some((1.0, 6.0)));
-        // n = 10: P(≤ 1) = 11/1024 per side, 2.1 % in all; P(≤ 2) = 56/1024, 10.9 %
-        assert_eq!(median_interval(values(10)), Some((2.0, 9.0)));
-        // n = 20: P(≤ 5) = 21700/2²⁰ per side, 4.1 % in all; P(≤ 6) = 60460/2²⁰, 11.5 %
-        assert_eq!(median_interval(values(20)), Some((6.0, 15.0)));
-        // n = 30: P(≤ 9) = 2.1 % per side, 4.3 % in all; P(≤ 10) = 4.9 % per side is too much
-        assert_eq!(median_interval(values(30)), Some((10.0, 21.0)));
-        // n = 2000: 2⁻²⁰⁰⁰ underflows an f64; the normal approximation puts k near
-        // 1000 − 1.96·√2000/2 ≈ 956
-        let (lo, hi) = median_interval(values(2000)).unwrap();
-        assert!((950.0..=960.0).contains(&lo), "{lo}");
-        assert_eq!(hi, 2001.0 - lo);
-    }
-
-    #[test]
     fn the_verdict_says_met_only_when_the_whole_interval_reaches_the_goal() {
-        let at = |v: &[f64]| verdict(v, 1.7);
+        let at = |v: &[f64]| in_words(&goal_verdict("2/1", v, 1.7));
         assert_eq!(
             at(&[1.8, 1.75, 1.9, 2.0, 1.71, 1.85]),
             "met (95 % interval of the median 1.710–2.000)"

@@ -227,52 +227,73 @@ fn err(file: &str, line: usize, msg: String) -> FormatError {
     }
 }
 
+/// Whether a record is a line of spaces or a comment after spaces (the reader skips empty
+/// lines and lines starting with `#`).
+fn blank_or_comment(record: &csv::StringRecord) -> bool {
+    record.iter().eq([""]) || record[0].starts_with('#')
+}
+
+/// A record that is not a row of 27 finite numbers: the message names the column.
+fn bad_row(record: &csv::StringRecord, e: csv::Error) -> String {
+    let field = match e.kind() {
+        csv::ErrorKind::Deserialize { err, .. } => err.field(),
+        _ => None,
+    };
+    match field.map(|c| c as usize) {
+        Some(c) if c < MOTION_COLUMNS.len() => format!(
+            "{}: not a finite number: {:?}",
+            MOTION_COLUMNS[c],
+            record.get(c).unwrap_or_default()
+        ),
+        _ => e.to_string(),
+    }
+}
+
 /// Parses a motion CSV (header line with [`MOTION_COLUMNS`], `#` comments allowed). Rejects
 /// missing or extra columns, non-numbers, times that do not increase and quaternions whose
 /// norm is not 1 within 1e-6, naming the file, line and column.
 pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatError> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = lines
-        .next()
+    let mut records = crate::io::csv_table::records(file, text, true);
+    let (hline, header) = records
+        .find(|r| r.as_ref().map_or(true, |(_, h)| !blank_or_comment(h)))
+        .transpose()?
         .ok_or_else(|| err(file, 1, "empty: expected a header line".into()))?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    if names != MOTION_COLUMNS {
+    if header.iter().ne(MOTION_COLUMNS) {
         return Err(err(
             file,
             hline,
             format!(
-                "header must be `{}`, got `{header}`",
-                MOTION_COLUMNS.join(",")
+                "header must be `{}`, got `{}`",
+                MOTION_COLUMNS.join(","),
+                text.lines().nth(hline - 1).unwrap_or_default().trim()
             ),
         ));
     }
     let mut rows: Vec<MotionRow> = Vec::new();
-    for (line, text) in lines {
-        let mut v = [0.0; 27];
-        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-        if fields.len() != 27 {
+    for record in records {
+        let (line, record) = record?;
+        if blank_or_comment(&record) {
+            continue;
+        }
+        if record.len() != 27 {
             return Err(err(
                 file,
                 line,
-                format!("expected 27 columns, got {}", fields.len()),
+                format!("expected 27 columns, got {}", record.len()),
             ));
         }
-        for (c, f) in fields.iter().enumerate() {
-            v[c] = f
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    err(
-                        file,
-                        line,
-                        format!("{}: not a finite number: {f:?}", MOTION_COLUMNS[c]),
-                    )
-                })?;
+        let v: [f64; 27] = record
+            .deserialize(None)
+            .map_err(|e| err(file, line, bad_row(&record, e)))?;
+        if let Some(c) = v.iter().position(|x| !x.is_finite()) {
+            return Err(err(
+                file,
+                line,
+                format!(
+                    "{}: not a finite number: {:?}",
+                    MOTION_COLUMNS[c], &record[c]
+                ),
+            ));
         }
         let sphere = |o: usize| -> Result<(Vec3, UnitQuaternion<f64>, Vec3, Vec3), FormatError> {
             let q = Quaternion::new(v[o + 3], v[o + 4], v[o + 5], v[o + 6]);
@@ -317,46 +338,38 @@ pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatErro
     Ok(rows)
 }
 
-fn push_csv(s: &mut String, values: &[f64]) {
-    for (c, v) in values.iter().enumerate() {
-        if c > 0 {
-            s.push(',');
-        }
-        crate::io::fmt_f64(s, *v);
-    }
-    s.push('\n');
-}
-
 /// A motion CSV of `rows` (round-trips bit for bit through [`parse_motion`]).
 pub fn motion_csv(rows: &[MotionRow]) -> String {
-    let mut s = MOTION_COLUMNS.join(",") + "\n";
-    for r in rows {
-        let mut v = vec![r.t];
-        for k in 0..2 {
-            let q = r.q[k].quaternion();
-            v.extend(r.x[k].iter());
-            v.extend([q.w, q.i, q.j, q.k]);
-            v.extend(r.v[k].iter());
-            v.extend(r.w[k].iter());
-        }
-        push_csv(&mut s, &v);
-    }
-    s
+    crate::io::csv_table::write(
+        MOTION_COLUMNS,
+        rows.iter().map(|r| {
+            let mut v = vec![r.t];
+            for k in 0..2 {
+                let q = r.q[k].quaternion();
+                v.extend(r.x[k].iter());
+                v.extend([q.w, q.i, q.j, q.k]);
+                v.extend(r.v[k].iter());
+                v.extend(r.w[k].iter());
+            }
+            v
+        }),
+    )
 }
 
 /// A forces CSV of `rows`.
 pub fn forces_csv(rows: &[ForceRow]) -> String {
-    let mut s = FORCE_COLUMNS.join(",") + "\n";
-    for r in rows {
-        let mut v = vec![r.t];
-        for k in 0..2 {
-            v.extend(r.f[k].iter());
-            v.extend(r.torque[k].iter());
-        }
-        v.extend([r.delta, r.fn_signed, r.ft]);
-        push_csv(&mut s, &v);
-    }
-    s
+    crate::io::csv_table::write(
+        FORCE_COLUMNS,
+        rows.iter().map(|r| {
+            let mut v = vec![r.t];
+            for k in 0..2 {
+                v.extend(r.f[k].iter());
+                v.extend(r.torque[k].iter());
+            }
+            v.extend([r.delta, r.fn_signed, r.ft]);
+            v
+        }),
+    )
 }
 
 #[cfg(test)]
@@ -392,6 +405,25 @@ mod tests {
 
         let e = parse_motion("m.csv", "t,x1\n").unwrap_err().to_string();
         assert!(e.starts_with("m.csv:1: header must be"), "{e}");
+        assert!(e.ends_with("got `t,x1`"), "{e}");
+
+        // comments and blank lines count in the line numbers
+        let commented = format!(
+            "# a motion\n\n   \n{}",
+            bad.replacen('\n', "\n  # row 1\n", 1)
+        );
+        let e = parse_motion("m.csv", &commented).unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:6: z2: not a finite number"), "{e}");
+        let e = parse_motion("m.csv", "# nothing\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.csv:1: empty"), "{e}");
+        let short = text.replacen(",0,0,0,0,", ",", 1);
+        let e = parse_motion("m.csv", &short).unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:2: expected 27 columns, got 23"), "{e}");
+        let nan = text.replacen("0.999,", "NaN,", 1);
+        let e = parse_motion("m.csv", &nan).unwrap_err().to_string();
+        assert_eq!(e, "m.csv:2: z2: not a finite number: \"NaN\"");
 
         let unnormalised = text.replacen(",1,0,0,0,", ",2,0,0,0,", 1);
         let e = parse_motion("m.csv", &unnormalised)

@@ -5,9 +5,9 @@
 //! read) into a [`state`] → [`step`] (the time step, top to bottom, under a [`contact`] law) →
 //! [`io`] (MercuryCG `.data`/`.fstat` saves, checkpoints, hash, diagnostics).
 
+pub mod analysis;
 pub mod bench;
 pub mod case;
-pub mod cg;
 pub mod contact;
 pub mod engine;
 pub mod io;
@@ -19,7 +19,6 @@ pub mod scene;
 pub mod state;
 pub mod step;
 pub mod team;
-pub mod tradeoff;
 pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.

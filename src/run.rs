@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
-use crate::io::{atomic, mercury};
+use crate::io::{atomic, csv_table, mercury};
 use crate::step::{Engine, StageTimes};
 
 /// Options of one run.
@@ -234,13 +234,16 @@ fn prepare_diagnostics(
     save_every: u64,
     resumed: bool,
 ) -> anyhow::Result<()> {
-    let mut text = String::from(CSV_HEADER);
+    let mut kept = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(CSV_HEADER.as_bytes().to_vec());
     if resumed {
         let old = std::fs::read_to_string(path).unwrap_or_default();
-        for (n, line) in old.lines().enumerate().skip(1) {
-            let mut fields = line.split(',').map(|f| f.parse::<u64>().ok());
-            let (Some(save), Some(row_step)) = (fields.next().flatten(), fields.next().flatten())
-            else {
+        let file = path.display().to_string();
+        for record in csv_table::records(&file, &old, false) {
+            let (line, record) = record?;
+            let field = |k: usize| record.get(k).and_then(|f| f.parse::<u64>().ok());
+            let (true, Some(save), Some(row_step)) = (line > 1, field(0), field(1)) else {
                 continue;
             };
             if row_step > step {
@@ -252,18 +255,15 @@ fn prepare_diagnostics(
                     _ => "the --save-every of the run that wrote it".into(),
                 };
                 bail!(
-                    "{}:{}: save {save} is at step {row_step}, but this run saves every \
-                     {save_every} steps; resume with {written_every}",
-                    path.display(),
-                    n + 1
+                    "{file}:{line}: save {save} is at step {row_step}, but this run saves every \
+                     {save_every} steps; resume with {written_every}"
                 );
             }
-            text.push_str(line);
-            text.push('\n');
+            kept.write_record(&record)?;
         }
     }
-    atomic::write(path, text.as_bytes())
-        .with_context(|| format!("{}: cannot write", path.display()))
+    let text = kept.into_inner()?;
+    atomic::write(path, &text).with_context(|| format!("{}: cannot write", path.display()))
 }
 
 fn progress_bar(opts: &RunOptions, start: u64) -> Option<indicatif::ProgressBar> {

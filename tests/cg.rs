@@ -4,7 +4,7 @@ mod common;
 
 use std::path::Path;
 
-use verdem::cg::{self, CgOptions, KernelChoice, COLUMNS};
+use verdem::analysis::cg::{self, CgOptions, KernelChoice, COLUMNS};
 use verdem::io::mercury;
 
 const AREA: f64 = 4.0 * 5.0;
@@ -310,9 +310,9 @@ fn checks_against_error_bars_need_two_blocks() {
     assert_eq!(blocks, 1, "{report}");
     let symmetric = |c: &[cg::checks::Check]| {
         c.iter()
-            .find(|c| c.name == "symmetric nu about the mid-plane")
+            .find(|c| c.quantity == "symmetric nu about the mid-plane")
             .unwrap()
-            .pass
+            .pass()
     };
     assert_eq!(symmetric(&checks), None, "{report}");
     assert!(!report.contains("FAIL"), "{report}");
@@ -324,4 +324,24 @@ fn checks_against_error_bars_need_two_blocks() {
     assert_eq!(blocks, 2, "{report}");
     assert_eq!(symmetric(&checks), Some(false), "{report}");
     assert!(!report.contains("not judged"), "{report}");
+}
+
+/// Every profiles table kept in golden/ reads back and is written again byte for byte.
+#[test]
+fn golden_profiles_tables_round_trip_byte_for_byte() {
+    let mut tables = vec![common::root().join("golden/full_run/shear_flow.profiles.csv")];
+    for dir in ["golden/peers", "golden/tradeoff"] {
+        for entry in std::fs::read_dir(common::root().join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.to_string_lossy().ends_with(".profiles.csv") {
+                tables.push(path);
+            }
+        }
+    }
+    assert!(tables.len() >= 13, "{tables:?}");
+    for path in tables {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let table = verdem::analysis::cg::table::Table::read(&path).unwrap();
+        assert!(table.csv() == text, "{}", path.display());
+    }
 }

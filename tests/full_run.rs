@@ -14,7 +14,7 @@
 mod common;
 
 use sha2::{Digest, Sha256};
-use verdem::cg::{self, table::Table, CgOptions};
+use verdem::analysis::cg::{self, table::Table, CgOptions};
 use verdem::engine::Overrides;
 
 fn golden(name: &str) -> std::path::PathBuf {

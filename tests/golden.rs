@@ -64,19 +64,21 @@ fn short_run(
 /// Coarse-grained profiles of all saves (20 Heaviside slices, 2 blocks), every number rounded to
 /// 6 significant digits.
 fn profiles(base: &std::path::Path) -> String {
-    let o = verdem::cg::CgOptions {
+    let o = verdem::analysis::cg::CgOptions {
         from: Some(0),
         to: None,
         slices: 20,
-        kernel: verdem::cg::KernelChoice::Heaviside,
+        kernel: verdem::analysis::cg::KernelChoice::Heaviside,
         width: None,
         walls: 480,
         density: 1.0,
         periodic: [true, true, false],
         blocks: 2,
     };
-    let p = verdem::cg::coarse_grain(&verdem::cg::Series::find(base).unwrap(), &o).unwrap();
-    verdem::cg::csv(&p)
+    let p =
+        verdem::analysis::cg::coarse_grain(&verdem::analysis::cg::Series::find(base).unwrap(), &o)
+            .unwrap();
+    verdem::analysis::cg::csv(&p)
         .lines()
         .map(|l| {
             l.split(',')

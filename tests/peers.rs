@@ -197,7 +197,7 @@ fn peers_give_the_restitution_of_the_closed_form_and_of_verdem() {
         let rows = peers::collision::rows(peer, &case, &dir.path().join(peer.binary())).unwrap();
         assert_eq!(rows.len(), 8);
         for r in &rows {
-            assert!(r.pass, "{r:?}");
+            assert!(r.passed(), "{r:?}");
         }
         for (v0, wall) in [(1.0, false), (0.1, true)] {
             let own = verdem::verify::collide(&case, v0, wall, 50.0).unwrap().e;

@@ -8,7 +8,7 @@ fn variants_change_what_they_should_and_nothing_else() {
     let pair = verdem::case::Case::load(&common::root().join("cases/verify/binary_collision.toml"))
         .unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let out = verdem::tradeoff::run(
+    let out = verdem::analysis::tradeoff::run(
         &case,
         &pair,
         &common::data("states/mercury_t143.85.data"),
@@ -44,12 +44,12 @@ fn variants_change_what_they_should_and_nothing_else() {
     }
     // the replica repeats the reference's physics over the next stretch: same law and cost,
     // other bits, and a χ² that measures the noise floor
-    let replica = by(verdem::tradeoff::REPLICA);
+    let replica = by(verdem::analysis::tradeoff::REPLICA);
     assert_eq!(replica.steps, reference.steps);
     assert_eq!(replica.restitution_error, reference.restitution_error);
     assert_ne!(replica.hash, reference.hash);
     assert!(replica.chi2.iter().all(|&c| c > 0.0), "{:?}", replica.chi2);
-    let table = verdem::tradeoff::markdown(&out);
+    let table = verdem::analysis::tradeoff::markdown(&out);
     assert_eq!(table.lines().count(), 2 + 10);
 }
 
@@ -59,7 +59,7 @@ fn variants_change_what_they_should_and_nothing_else() {
 /// time steps) in each profile.
 #[test]
 fn the_recorded_trade_over_300_time_units_says_what_the_readme_says() {
-    use verdem::cg::table::Table;
+    use verdem::analysis::cg::table::Table;
     let dir = common::root().join("golden/tradeoff");
     let names = [
         "reference",
@@ -77,9 +77,9 @@ fn the_recorded_trade_over_300_time_units_says_what_the_readme_says() {
             (n.to_string(), t)
         })
         .collect();
-    let rows = verdem::cg::compare::compare(&tables[0].1, &tables[1..]).unwrap();
+    let rows = verdem::analysis::cg::compare::compare(&tables[0].1, &tables[1..]).unwrap();
     assert_eq!(
-        verdem::cg::compare::markdown("reference", &rows),
+        verdem::analysis::cg::compare::markdown("reference", &rows),
         std::fs::read_to_string(dir.join("compare.md")).unwrap()
     );
     let chi2 = |name: &str| rows.iter().find(|r| r.name == name).unwrap().chi2;

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
+use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
-use verdem::cg::{self, CgOptions, KernelChoice};
 
 use super::args::{count, named, positive};
 use super::Finished;

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use verdem::cg::{compare, plot, table::Table};
+use verdem::analysis::cg::{compare, plot, table::Table};
 
 use super::Finished;
 

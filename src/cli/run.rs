@@ -7,8 +7,8 @@ use std::sync::Arc;
 
 use anyhow::Context;
 
+use verdem::analysis::cg::{self, CgOptions};
 use verdem::case::{Case, Scene};
-use verdem::cg::{self, CgOptions};
 use verdem::io::checkpoint;
 use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
 

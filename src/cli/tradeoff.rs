@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
+use verdem::analysis::tradeoff;
 use verdem::case::Case;
 use verdem::io::atomic;
-use verdem::tradeoff;
 
 use super::args::{count, positive};
 use super::Finished;

@@ -40,7 +40,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         }
     }
     print!("{}", verify::table(&rows));
-    let passed = rows.iter().filter(|r| r.pass).count();
+    let passed = rows.iter().filter(|r| r.passed()).count();
     let failed = verify::failures(&rows);
     println!(
         "{passed} passed, {failed} failed, {} known defects of peer conventions (FAIL*)",

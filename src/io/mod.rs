@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod checkpoint;
+pub mod csv_table;
 pub mod diagnostics;
 pub mod hash;
 pub mod mercury;

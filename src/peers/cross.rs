@@ -16,8 +16,10 @@ use std::path::Path;
 use anyhow::{ensure, Context};
 
 use super::Peer;
+use crate::analysis::cg::{self, table::Table};
+use crate::analysis::stats::quantile;
+use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential};
-use crate::cg::{self, table::Table};
 use crate::engine::{self, Overrides};
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
@@ -31,16 +33,12 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(mut v: Vec<f64>) -> Spread {
-        if v.is_empty() {
-            return Spread::default();
-        }
-        v.sort_by(f64::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+    /// The spread of `v` (nearest-rank quantiles; all 0 for no values).
+    fn of(v: &[f64]) -> Spread {
         Spread {
-            max: v[v.len() - 1],
-            median: at(0.5),
-            p99: at(0.99),
+            max: quantile(v, 1.0),
+            median: quantile(v, 0.5),
+            p99: quantile(v, 0.99),
         }
     }
 }
@@ -76,6 +74,17 @@ impl Report {
             .map(|s| s.step)
     }
 
+    /// The χ²/dof of each profile of [`cg::FIELDS`] against verdem's, as reported verdicts
+    /// (≈ 1 when the two differ by noise only; the quantity is the profile's name, the case
+    /// the peer's).
+    pub fn profile_verdicts(&self) -> Vec<Verdict> {
+        cg::FIELDS
+            .iter()
+            .zip(self.profiles_chi2)
+            .map(|((name, _), c)| Verdict::reported(self.peer.binary(), name, c, Limit::None))
+            .collect()
+    }
+
     /// The comparison as a markdown table with a summary line.
     pub fn markdown(&self) -> String {
         let mut s = format!(
@@ -99,10 +108,10 @@ impl Report {
             Some(step) => writeln!(s, "\nlargest |dx| first exceeds 1e-6 at step {step}"),
             None => writeln!(s, "\nlargest |dx| stays within 1e-6 up to step {last}"),
         };
-        let chi2: Vec<String> = cg::FIELDS
+        let chi2: Vec<String> = self
+            .profile_verdicts()
             .iter()
-            .zip(self.profiles_chi2)
-            .map(|((name, _), c)| format!("{name} {c:.2}"))
+            .map(|v| format!("{} {:.2}", v.quantity, v.measured))
             .collect();
         let _ = writeln!(
             s,
@@ -179,7 +188,7 @@ pub fn cross(
         atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
         let (a, b) = (&own.particles, &theirs.particles);
         let n = a.len();
-        let diff = |f: &dyn Fn(usize) -> f64| Spread::of((0..n).map(f).collect());
+        let diff = |f: &dyn Fn(usize) -> f64| Spread::of(&(0..n).map(f).collect::<Vec<_>>());
         saves.push(SaveDiff {
             step: k * every,
             dx: diff(&|i| own.domain.min_image(b.x[i] - a.x[i]).norm()),

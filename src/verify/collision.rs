@@ -5,7 +5,8 @@
 //! free–free (m_eff = m/2) and free–wall sphere (m_eff = m), for impact speeds 1e-3 … 10, and
 //! the convergence order of the restitution error in dt.
 
-use super::{row, slope, Row};
+use super::{row, Row};
+use crate::analysis::stats::slope;
 use crate::case::{Case, Scene};
 use crate::engine::{self, Overrides};
 use crate::Vec3;

@@ -79,7 +79,7 @@ pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
     }
     Ok(GasRun {
         energy_deviation: deviation,
-        energy_drift: super::slope(&pts),
+        energy_drift: crate::analysis::stats::slope(&pts),
         momentum_change: dp,
     })
 }

@@ -17,75 +17,38 @@ pub mod ratchet;
 
 use std::path::Path;
 
+use crate::analysis::{Limit, Verdict};
 use crate::case::Case;
 pub use collision::{binary_collisions, closed_form, collide, ClosedForm, Measured};
 
-/// One line of the verification table.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Row {
-    pub case: String,
-    pub quantity: String,
-    pub expected: f64,
-    pub measured: f64,
-    /// Allowed error: relative to `expected`, or absolute when `absolute`.
-    pub tolerance: f64,
-    pub absolute: bool,
-    pub pass: bool,
-    /// Whether a failure of this row fails `verdem verify`. Rows that document a peer
-    /// convention's known defect (e.g. no twist of the spring) are shown but do not gate.
-    pub gate: bool,
-}
-
-impl Row {
-    /// The same row, shown as evidence about a peer convention rather than gating.
-    pub fn documenting(mut self) -> Row {
-        self.gate = false;
-        self
-    }
-
-    /// The same row, gating only when `gate` (a verdem claim), else documenting.
-    pub fn gating_if(self, gate: bool) -> Row {
-        if gate {
-            self
-        } else {
-            self.documenting()
-        }
-    }
-}
-
-fn judged(
-    case: &str,
-    quantity: &str,
-    expected: f64,
-    measured: f64,
-    tolerance: f64,
-    absolute: bool,
-) -> Row {
-    let err = if absolute {
-        (measured - expected).abs()
-    } else {
-        ((measured - expected) / expected).abs()
-    };
-    Row {
-        case: case.into(),
-        quantity: quantity.into(),
-        expected,
-        measured,
-        tolerance,
-        absolute,
-        pass: err <= tolerance,
-        gate: true,
-    }
-}
+/// One line of the verification table: a case's quantity judged against its expected value
+/// with a relative ([`row`]) or absolute ([`row_abs`]) tolerance.
+pub type Row = Verdict;
 
 /// A row judged by the relative error |measured − expected|/|expected|.
 pub fn row(case: &str, quantity: &str, expected: f64, measured: f64, tolerance: f64) -> Row {
-    judged(case, quantity, expected, measured, tolerance, false)
+    Verdict::judge(
+        case,
+        quantity,
+        measured,
+        Limit::Relative {
+            expected,
+            tolerance,
+        },
+    )
 }
 
 /// A row judged by the absolute error |measured − expected|.
 pub fn row_abs(case: &str, quantity: &str, expected: f64, measured: f64, tolerance: f64) -> Row {
-    judged(case, quantity, expected, measured, tolerance, true)
+    Verdict::judge(
+        case,
+        quantity,
+        measured,
+        Limit::Absolute {
+            expected,
+            tolerance,
+        },
+    )
 }
 
 /// Every verification case of the folder `dir` (cases/verify): the table `verdem verify`
@@ -102,22 +65,8 @@ pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Least-squares slope of (x, y) points.
-pub fn slope(p: &[(f64, f64)]) -> f64 {
-    let n = p.len() as f64;
-    let (mx, my) = (
-        p.iter().map(|q| q.0).sum::<f64>() / n,
-        p.iter().map(|q| q.1).sum::<f64>() / n,
-    );
-    let sxy: f64 = p.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
-    let sxx: f64 = p.iter().map(|q| (q.0 - mx).powi(2)).sum();
-    sxy / sxx
-}
-
 /// Rows that gate and failed.
-pub fn failures(rows: &[Row]) -> usize {
-    rows.iter().filter(|r| r.gate && !r.pass).count()
-}
+pub use crate::analysis::verdict::failures;
 
 /// The table as text; tolerances marked `abs` are absolute, the others relative. A failed row
 /// that documents a peer convention's known defect reads `FAIL*`.
@@ -127,22 +76,23 @@ pub fn table(rows: &[Row]) -> String {
         "case", "quantity", "expected", "measured", "tolerance"
     );
     for r in rows {
-        let tol = format!(
-            "{:.1e}{}",
-            r.tolerance,
-            if r.absolute { " abs" } else { " rel" }
-        );
+        let tol = match r.limit {
+            Limit::Relative { tolerance, .. } => format!("{tolerance:.1e} rel"),
+            Limit::Absolute { tolerance, .. } => format!("{tolerance:.1e} abs"),
+            _ => String::new(),
+        };
         s.push_str(&format!(
             "{:<56} {:<40} {:>13.6e} {:>13.6e} {:>13}  {}\n",
             r.case,
             r.quantity,
-            r.expected,
+            r.limit.expected(),
             r.measured,
             tol,
-            match (r.pass, r.gate) {
-                (true, _) => "PASS",
-                (false, true) => "FAIL",
-                (false, false) => "FAIL*",
+            match (r.pass(), r.gate) {
+                (Some(true), _) => "PASS",
+                (Some(false), true) => "FAIL",
+                (Some(false), false) => "FAIL*",
+                (None, _) => "info",
             }
         ));
     }

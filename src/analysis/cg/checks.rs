@@ -2,17 +2,13 @@
 //! symmetry, steadiness across the blocks of saves, and a kinetic-theory sanity check
 //! (reported, never failed).
 
-use super::{columns, core_range, standard_error, Profiles, COLUMNS};
+use super::{columns, core_range, Profiles, COLUMNS};
+use crate::analysis::stats::{block, standard_error, trend, weighted_mean_chi2};
+use crate::analysis::{Limit, Verdict};
 
-/// One check: what was measured against what was expected, and whether it passed
-/// (`None`: reported only).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Check {
-    pub name: String,
-    pub measured: String,
-    pub expected: String,
-    pub pass: Option<bool>,
-}
+/// One check: its name is the verdict's quantity; the report prints the measurement and the
+/// expectation in words.
+pub type Check = Verdict;
 
 /// How the name of the steadiness check starts.
 const STEADY: &str = "steady:";
@@ -22,7 +18,7 @@ const STEADY: &str = "steady:";
 fn unsteady_note(checks: &[Check]) -> Option<&'static str> {
     checks
         .iter()
-        .any(|c| c.name.starts_with(STEADY) && c.pass == Some(false))
+        .any(|c| c.quantity.starts_with(STEADY) && c.failed())
         .then_some(
             "note: the flow is not steady over these saves, and the uniformity, wall and \
              symmetry checks judge a steady flow. From rest the shear flow is still developing \
@@ -36,56 +32,6 @@ fn col(name: &str) -> usize {
         .iter()
         .position(|c| *c == name)
         .expect("known column")
-}
-
-/// Reduced chi-square of values against their error-weighted mean.
-fn uniformity(v: &[f64], se: &[f64]) -> (f64, f64) {
-    let w: Vec<f64> = se.iter().map(|s| 1.0 / (s * s).max(1e-300)).collect();
-    let mean = v.iter().zip(&w).map(|(x, w)| x * w).sum::<f64>() / w.iter().sum::<f64>();
-    let chi2 = v
-        .iter()
-        .zip(se)
-        .map(|(x, s)| ((x - mean) / s.max(1e-300)).powi(2))
-        .sum::<f64>();
-    (mean, chi2 / (v.len() as f64 - 1.0).max(1.0))
-}
-
-/// Least-squares line through equally spaced values `y`: its change from the first to the last
-/// point relative to the mean, and its slope in units of the slope's standard error (from the
-/// residuals; ±∞ for an exact line, 0 for fewer than three points or constant values).
-fn trend(y: &[f64]) -> (f64, f64) {
-    let n = y.len() as f64;
-    if y.len() < 3 {
-        return (0.0, 0.0);
-    }
-    let x_mean = (n - 1.0) / 2.0;
-    let y_mean = y.iter().sum::<f64>() / n;
-    let sxx: f64 = (0..y.len()).map(|i| (i as f64 - x_mean).powi(2)).sum();
-    let slope = y
-        .iter()
-        .enumerate()
-        .map(|(i, v)| (i as f64 - x_mean) * (v - y_mean))
-        .sum::<f64>()
-        / sxx;
-    let residual: f64 = y
-        .iter()
-        .enumerate()
-        .map(|(i, v)| (v - y_mean - slope * (i as f64 - x_mean)).powi(2))
-        .sum();
-    let se = (residual / (n - 2.0) / sxx).sqrt();
-    let change = if y_mean != 0.0 {
-        slope * (n - 1.0) / y_mean
-    } else {
-        0.0
-    };
-    let t = if se > 0.0 {
-        slope / se
-    } else if slope == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY.copysign(slope)
-    };
-    (change, t)
 }
 
 /// Runs every check. `density` is the particle density (for the kinetic-theory check).
@@ -112,14 +58,21 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     // 1. Momentum balance: shear stress and σzz uniform across the core.
     let (tau_mean, tau_chi) = {
         let (v, se) = get("shear_xz");
-        uniformity(&v, &se)
+        weighted_mean_chi2(&v, &se)
     };
-    out.push(Check {
-        name: format!("shear stress uniform for z in [{z0:.2}, {z1:.2}]"),
-        measured: format!("chi2/dof = {tau_chi:.2} (mean {tau_mean:.5})"),
-        expected: format!("< {limit}{unjudged}"),
-        pass: judged.then_some(tau_chi < limit),
-    });
+    out.push(
+        Verdict::judge(
+            "",
+            &format!("shear stress uniform for z in [{z0:.2}, {z1:.2}]"),
+            tau_chi,
+            Limit::Below(limit),
+        )
+        .judged_if(judged)
+        .described(
+            format!("chi2/dof = {tau_chi:.2} (mean {tau_mean:.5})"),
+            format!("< {limit}{unjudged}"),
+        ),
+    );
     let zz: Vec<f64> = core
         .clone()
         .map(|k| cols[k][col("kin_zz")] + cols[k][col("con_zz")])
@@ -128,13 +81,20 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         .clone()
         .map(|k| (p.se[k][col("kin_zz")].powi(2) + p.se[k][col("con_zz")].powi(2)).sqrt())
         .collect();
-    let (zz_mean, zz_chi) = uniformity(&zz, &zz_se);
-    out.push(Check {
-        name: format!("sigma_zz uniform for z in [{z0:.2}, {z1:.2}]"),
-        measured: format!("chi2/dof = {zz_chi:.2} (mean {zz_mean:.5})"),
-        expected: format!("< {limit}{unjudged}"),
-        pass: judged.then_some(zz_chi < limit),
-    });
+    let (zz_mean, zz_chi) = weighted_mean_chi2(&zz, &zz_se);
+    out.push(
+        Verdict::judge(
+            "",
+            &format!("sigma_zz uniform for z in [{z0:.2}, {z1:.2}]"),
+            zz_chi,
+            Limit::Below(limit),
+        )
+        .judged_if(judged)
+        .described(
+            format!("chi2/dof = {zz_chi:.2} (mean {zz_mean:.5})"),
+            format!("< {limit}{unjudged}"),
+        ),
+    );
     // 2. Wall consistency: σ·n at each wall equals the wall force per area. Top wall (normal
     // +z): σxz = F_top,x/A, σzz = F_top,z/A; bottom wall: σxz = −F_bot,x/A, σzz = −F_bot,z/A.
     let area = p.domain.lengths().x * p.domain.lengths().y;
@@ -143,8 +103,9 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         let n = p.wall_force.len();
         let vals: Vec<f64> = (0..blocks)
             .map(|b| {
-                let (s, e) = (b * n / blocks, (b + 1) * n / blocks);
-                (s..e).map(f).sum::<f64>() / (e - s) as f64
+                let saves = block(b, blocks, n);
+                let len = saves.len();
+                saves.map(f).sum::<f64>() / len as f64
             })
             .collect();
         (
@@ -171,12 +132,22 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             ("zz", zz_mean, fz, zz_core_se, fz_se),
         ] {
             let tol = 3.0 * (se_gap * se_gap + se_wall * se_wall).sqrt();
-            out.push(Check {
-                name: format!("sigma_{what} in the core = {label} wall force per area"),
-                measured: format!("{gap:.5} vs {wall:.5}"),
-                expected: format!("difference < 3 combined SE ({tol:.2e}){unjudged}"),
-                pass: judged.then_some((gap - wall).abs() <= tol),
-            });
+            out.push(
+                Verdict::judge(
+                    "",
+                    &format!("sigma_{what} in the core = {label} wall force per area"),
+                    gap - wall,
+                    Limit::Absolute {
+                        expected: 0.0,
+                        tolerance: tol,
+                    },
+                )
+                .judged_if(judged)
+                .described(
+                    format!("{gap:.5} vs {wall:.5}"),
+                    format!("difference < 3 combined SE ({tol:.2e}){unjudged}"),
+                ),
+            );
         }
     }
     // 3. Mass: ∫ ν dz · Lx·Ly = Σ V_i, per save.
@@ -188,18 +159,24 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         .fold(0.0, f64::max);
     let exact = matches!(p.kernel, super::kernel::Kernel::Heaviside { .. });
     let tol = if exact { 1e-12 } else { 1e-3 };
-    out.push(Check {
-        name: format!(
-            "mass: integral of nu dz * Lx * Ly = {} free spheres' volume",
-            p.free
+    out.push(
+        Verdict::judge(
+            "",
+            &format!(
+                "mass: integral of nu dz * Lx * Ly = {} free spheres' volume",
+                p.free
+            ),
+            worst,
+            Limit::Below(tol),
+        )
+        .described(
+            format!(
+                "max relative error {worst:.2e} over {} saves",
+                p.per_save.len()
+            ),
+            format!("< {tol:e}"),
         ),
-        measured: format!(
-            "max relative error {worst:.2e} over {} saves",
-            p.per_save.len()
-        ),
-        expected: format!("< {tol:e}"),
-        pass: Some(worst < tol),
-    });
+    );
     // 4. Symmetry about the mid-plane.
     let n = p.grid.n;
     for (name, sign) in [("nu", 1.0), ("T", 1.0), ("pressure", 1.0), ("vx", -1.0)] {
@@ -218,19 +195,22 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             })
             .collect();
         let chi = pairs.iter().sum::<f64>() / pairs.len() as f64;
-        out.push(Check {
-            name: format!(
-                "{} {name} about the mid-plane",
-                if sign > 0.0 {
-                    "symmetric"
-                } else {
-                    "antisymmetric"
-                }
-            ),
-            measured: format!("chi2/dof = {chi:.2}"),
-            expected: format!("< {limit}{unjudged}"),
-            pass: judged.then_some(chi < limit),
-        });
+        let quantity = format!(
+            "{} {name} about the mid-plane",
+            if sign > 0.0 {
+                "symmetric"
+            } else {
+                "antisymmetric"
+            }
+        );
+        out.push(
+            Verdict::judge("", &quantity, chi, Limit::Below(limit))
+                .judged_if(judged)
+                .described(
+                    format!("chi2/dof = {chi:.2}"),
+                    format!("< {limit}{unjudged}"),
+                ),
+        );
     }
     // 5. Steadiness: no trend of the core's fluctuation energy ½ tr σ_kin across the blocks
     //    (its name starts with STEADY, which `unsteady_note` looks for).
@@ -245,18 +225,25 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         })
         .collect();
     let (change, t) = trend(&energy);
-    out.push(Check {
-        name: format!(
-            "{STEADY} core fluctuation energy density has no trend across the {} blocks",
-            energy.len()
+    out.push(
+        Verdict::judge(
+            "",
+            &format!(
+                "{STEADY} core fluctuation energy density has no trend across the {} blocks",
+                energy.len()
+            ),
+            t.abs(),
+            Limit::Below(3.0),
+        )
+        .judged_if(energy.len() >= 4)
+        .described(
+            format!(
+                "linear change {:+.2} % over the saves, {t:+.2} standard errors",
+                100.0 * change
+            ),
+            "|trend| < 3 standard errors (reported only with fewer than 4 blocks)".into(),
         ),
-        measured: format!(
-            "linear change {:+.2} % over the saves, {t:+.2} standard errors",
-            100.0 * change
-        ),
-        expected: "|trend| < 3 standard errors (reported only with fewer than 4 blocks)".into(),
-        pass: (energy.len() >= 4).then_some(t.abs() < 3.0),
-    });
+    );
     // 6. Kinetic theory: p/(ρp ν T) against 1 + 2(1+e) ν g0(ν), Carnahan–Starling g0 (reported).
     let e = 0.902;
     let ratios: Vec<f64> = core
@@ -270,12 +257,21 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         })
         .collect();
     let mean_ratio = ratios.iter().sum::<f64>() / ratios.len().max(1) as f64;
-    out.push(Check {
-        name: "kinetic theory p/(rho_p nu T) / (1 + 2(1+e) nu g0), core mean".into(),
-        measured: format!("{mean_ratio:.3}"),
-        expected: "about 1 (within ~20%; reported only)".into(),
-        pass: None,
-    });
+    out.push(
+        Verdict::reported(
+            "",
+            "kinetic theory p/(rho_p nu T) / (1 + 2(1+e) nu g0), core mean",
+            mean_ratio,
+            Limit::Relative {
+                expected: 1.0,
+                tolerance: 0.2,
+            },
+        )
+        .described(
+            format!("{mean_ratio:.3}"),
+            "about 1 (within ~20%; reported only)".into(),
+        ),
+    );
     out
 }
 
@@ -306,14 +302,14 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
         block_len,
     );
     for c in checks {
-        let verdict = match c.pass {
+        let verdict = match c.pass() {
             Some(true) => "PASS",
             Some(false) => "FAIL",
             None => "info",
         };
         s.push_str(&format!(
             "{verdict:4}  {}: {} (expected {})\n",
-            c.name, c.measured, c.expected
+            c.quantity, c.measured_text, c.expected_text
         ));
     }
     if let Some(note) = unsteady_note(checks) {
@@ -325,15 +321,13 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{trend, unsteady_note, Check, STEADY};
+    use super::{unsteady_note, Limit, Verdict, STEADY};
 
     #[test]
     fn only_a_failed_steadiness_check_adds_the_note() {
-        let check = |name: &str, pass| Check {
-            name: name.into(),
-            measured: String::new(),
-            expected: String::new(),
-            pass,
+        let check = |name: &str, pass: Option<bool>| {
+            let measured = if pass == Some(false) { 5.0 } else { 1.0 };
+            Verdict::judge("", name, measured, Limit::Below(3.0)).judged_if(pass.is_some())
         };
         let steady = |pass| check(&format!("{STEADY} trend"), pass);
         let uniform = check("sigma_zz uniform", Some(false));
@@ -345,23 +339,5 @@ mod tests {
             unsteady_note(&[check("sigma_zz uniform", Some(false))]),
             None
         );
-    }
-
-    #[test]
-    fn a_trend_is_measured_against_its_scatter() {
-        // exact line 10, 11, …, 14: a rise of 4 over a mean of 12, with no scatter
-        let (change, t) = trend(&[10.0, 11.0, 12.0, 13.0, 14.0]);
-        assert!((change - 4.0 / 12.0).abs() < 1e-12, "{change}");
-        assert_eq!(t, f64::INFINITY, "an exact line is a trend");
-        assert_eq!(trend(&[3.0; 5]), (0.0, 0.0));
-        // alternating scatter of ±1 around a flat line: no trend
-        let (change, t) = trend(&[1.0, -1.0, 1.0, -1.0, 1.0, -1.0].map(|v| 10.0 + v));
-        assert!(change.abs() < 0.15 && t.abs() < 1.0, "{change} {t}");
-        // a clear rise through scatter
-        let y: Vec<f64> = (0..10)
-            .map(|i| 10.0 + i as f64 + if i % 2 == 0 { 0.3 } else { -0.3 })
-            .collect();
-        let (_, t) = trend(&y);
-        assert!(t > 10.0, "{t}");
     }
 }

@@ -99,7 +99,7 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cg::COLUMNS;
+    use crate::analysis::cg::COLUMNS;
 
     /// A 100-slice table over [0, 22] whose every column is `value` with standard error `se`.
     fn flat(value: f64, se: f64) -> Table {

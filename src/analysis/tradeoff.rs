@@ -17,8 +17,8 @@
 
 use std::path::Path;
 
+use crate::analysis::cg::{self, CgOptions, Series};
 use crate::case::Case;
-use crate::cg::{self, CgOptions, Series};
 use crate::engine::{self, Overrides};
 use crate::run::{self, RunOptions};
 use crate::verify::{closed_form, collide};

@@ -1,7 +1,8 @@
 //! Profiles as a table of numbers: written as CSV, read back (golden peer profiles are stored
 //! this way), and compared slice by slice against their combined standard errors.
 
-use crate::io::{read_text, FormatError};
+use crate::analysis::stats::mean_chi2;
+use crate::io::{csv_table, read_text, FormatError};
 
 use super::{columns, Grid, Profiles, COLUMNS};
 
@@ -39,19 +40,13 @@ impl Table {
 
     /// The CSV text: z, then every column of [`COLUMNS`] followed by its standard error.
     pub fn csv(&self) -> String {
-        let mut s = header();
-        s.push('\n');
-        for k in 0..self.z.len() {
-            crate::io::fmt_f64(&mut s, self.z[k]);
-            for (v, e) in self.mean[k].iter().zip(&self.se[k]) {
-                s.push(',');
-                crate::io::fmt_f64(&mut s, *v);
-                s.push(',');
-                crate::io::fmt_f64(&mut s, *e);
-            }
-            s.push('\n');
-        }
-        s
+        csv_table::write(
+            header(),
+            (0..self.z.len()).map(|k| {
+                let pairs = self.mean[k].iter().zip(&self.se[k]);
+                std::iter::once(self.z[k]).chain(pairs.flat_map(|(v, e)| [*v, *e]))
+            }),
+        )
     }
 
     /// Reads a table written by [`Table::csv`]; a wrong header or a bad number is reported
@@ -63,35 +58,29 @@ impl Table {
             line,
             msg,
         };
-        let mut lines = text.lines();
-        if lines.next() != Some(header().as_str()) {
-            return Err(fail(1, "not a profiles table (unexpected header)".into()));
+        let mut records = csv_table::records(&file, &text, false);
+        match records.next().transpose()? {
+            Some((1, names)) if names.iter().eq(header()) => {}
+            _ => return Err(fail(1, "not a profiles table (unexpected header)".into())),
         }
         let mut table = Table {
             z: Vec::new(),
             mean: Vec::new(),
             se: Vec::new(),
         };
-        for (n, line) in lines.enumerate() {
-            let line_no = n + 2;
-            let mut row = Vec::with_capacity(1 + 2 * COLUMNS.len());
-            for (col, tok) in line.split(',').enumerate() {
-                let name = if col == 0 {
-                    "z".to_string()
-                } else {
-                    let c = COLUMNS[(col - 1).min(COLUMNS.len() * 2 - 1) / 2];
-                    if col % 2 == 1 {
-                        c.to_string()
-                    } else {
-                        format!("{c}_se")
-                    }
+        for record in records {
+            let (line_no, record) = record?;
+            let row: Vec<f64> = record.deserialize(None).map_err(|e| {
+                let col = match e.kind() {
+                    csv::ErrorKind::Deserialize { err, .. } => err.field().unwrap_or(0) as usize,
+                    _ => 0,
                 };
-                let v: f64 = tok
-                    .trim()
-                    .parse()
-                    .map_err(|_| fail(line_no, format!("field {name}: not a number: {tok:?}")))?;
-                row.push(v);
-            }
+                let tok = record.get(col).unwrap_or_default();
+                fail(
+                    line_no,
+                    format!("field {}: not a number: {tok:?}", field_name(col)),
+                )
+            })?;
             if row.len() != 1 + 2 * COLUMNS.len() {
                 return Err(fail(
                     line_no,
@@ -111,13 +100,23 @@ impl Table {
     }
 }
 
-/// The CSV header line (without its newline).
-fn header() -> String {
-    let mut s = String::from("z");
-    for c in COLUMNS {
-        s.push_str(&format!(",{c},{c}_se"));
+/// The names of the CSV's fields: z, then each column of [`COLUMNS`] and its standard error.
+fn header() -> Vec<String> {
+    (0..1 + 2 * COLUMNS.len()).map(field_name).collect()
+}
+
+/// The name of field `col` (from 0) of a profiles table; fields past the last are named as the
+/// last.
+fn field_name(col: usize) -> String {
+    if col == 0 {
+        return "z".into();
     }
-    s
+    let c = COLUMNS[(col - 1).min(COLUMNS.len() * 2 - 1) / 2];
+    if col % 2 == 1 {
+        c.to_string()
+    } else {
+        format!("{c}_se")
+    }
 }
 
 /// χ²/dof of column `col` of `a` against `b` over the grid points with z in `window`: the mean
@@ -130,18 +129,16 @@ pub fn chi2(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Res
         a.z.len(),
         b.z.len()
     );
-    let (mut sum, mut n) = (0.0, 0usize);
-    for k in 0..a.z.len() {
-        if a.z[k] < window.0 || a.z[k] > window.1 {
-            continue;
-        }
-        let var = a.se[k][col].powi(2) + b.se[k][col].powi(2);
-        if var > 0.0 {
-            sum += (a.mean[k][col] - b.mean[k][col]).powi(2) / var;
-            n += 1;
-        }
-    }
-    Ok(if n == 0 { 0.0 } else { sum / n as f64 })
+    Ok(mean_chi2(
+        (0..a.z.len())
+            .filter(|&k| !(a.z[k] < window.0 || a.z[k] > window.1))
+            .map(|k| {
+                (
+                    a.mean[k][col] - b.mean[k][col],
+                    a.se[k][col].powi(2) + b.se[k][col].powi(2),
+                )
+            }),
+    ))
 }
 
 #[cfg(test)]

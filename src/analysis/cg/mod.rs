@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 
+use crate::analysis::stats::{block, integrated_autocorrelation, standard_error};
 use crate::io::mercury;
 use crate::state::Domain;
 use fields::{derive, raw_fields, Derived, Grid, Raw};
@@ -302,11 +303,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     let blocks = o.blocks.clamp(1, per_save.len());
     let block_cols: Vec<Vec<Vec<f64>>> = (0..blocks)
         .map(|b| {
-            let (s, e) = (
-                b * per_save.len() / blocks,
-                (b + 1) * per_save.len() / blocks,
-            );
-            derive(&average(&per_save[s..e]))
+            derive(&average(&per_save[block(b, blocks, per_save.len())]))
                 .iter()
                 .map(columns)
                 .collect()
@@ -391,43 +388,6 @@ fn average(raws: &[Raw]) -> Raw {
         m.add_scaled(r, 1.0 / raws.len() as f64);
     }
     m
-}
-
-/// Standard error of the mean of independent values (0 for fewer than two).
-pub fn standard_error(v: &[f64]) -> f64 {
-    let n = v.len() as f64;
-    if v.len() < 2 {
-        return 0.0;
-    }
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (var / n).sqrt()
-}
-
-/// Integrated autocorrelation time τ = 1/2 + Σ ρ(t), summed up to the first window W ≥ 5τ
-/// (Sokal's automatic window), in units of the series' spacing.
-pub fn integrated_autocorrelation(x: &[f64]) -> f64 {
-    let n = x.len();
-    if n < 4 {
-        return f64::NAN;
-    }
-    let mean = x.iter().sum::<f64>() / n as f64;
-    let c0 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-    if c0 == 0.0 {
-        return 0.5;
-    }
-    let mut tau = 0.5;
-    for t in 1..n / 2 {
-        let c = (0..n - t)
-            .map(|i| (x[i] - mean) * (x[i + t] - mean))
-            .sum::<f64>()
-            / n as f64;
-        tau += c / c0;
-        if t as f64 >= 5.0 * tau {
-            break;
-        }
-    }
-    tau.max(0.5)
 }
 
 /// The profiles as CSV: z, then every column of [`COLUMNS`] followed by its standard error.
