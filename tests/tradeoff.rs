@@ -54,7 +54,7 @@ fn variants_change_what_they_should_and_nothing_else() {
 }
 
 /// The recorded trade over 300 time units (golden/tradeoff, see its provenance.toml): its
-/// compare.md is what `verdem compare` gives on the stored profiles, and what the README says of
+/// compare.md is what `verdem compare` gives on the stored profiles, and what docs/performance.md says of
 /// it holds. The floor is the largest χ² of the same-physics runs (the replica and the finer
 /// time steps) in each profile.
 #[test]
