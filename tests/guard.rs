@@ -146,5 +146,8 @@ fn the_overlap_limit_is_read_from_the_case_and_checked() {
     std::fs::write(&case, format!("{text}[guard]\noverlap = 1.5\n")).unwrap();
     let (code, err) = run(&case, &dir.path().join("wide"));
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("guard: overlap"), "{err}");
+    assert!(
+        err.contains("guard.overlap: a fraction of the smaller radius at most 1"),
+        "{err}"
+    );
 }
