@@ -40,8 +40,9 @@ pub(super) struct PairSlots<'a, H> {
 /// [`crate::neighbor::rebuild::gap_closed`]), then the live prefix of each class is visited. A
 /// pair beyond reach cannot touch yet; its slot stays inactive, exactly as a full pass would
 /// leave it. The first `CLASSES / 2` classes hold interior pairs, whose direct separation is
-/// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns
-/// the first overlap beyond the guard's limit, if any.
+/// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns,
+/// for the run guard, the largest overlap of the chunk's contacts as a fraction of their smaller
+/// radius (0 without a contact; infinite when a contact's force or torque is not finite).
 ///
 /// # Safety
 /// `arr` is valid; chunk `c` is taken by this thread alone; no thread writes the particles of
@@ -53,8 +54,8 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
     touched: &[AtomicBool],
     c: usize,
     closed: [f64; 3],
-) -> Option<Breach> {
-    let mut breach = None;
+) -> f64 {
+    let mut worst = 0.0f64;
     let seg = arr.pair_ranges.get(c);
     let ends = arr.live.at_mut(c);
     let gap = arr.gap.slice(0..arr.gap.len());
@@ -76,19 +77,43 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
             active: arr.active.slice_mut(a..b),
             out: arr.out.slice_mut(a..b),
         };
-        let found = if class < CLASSES / 2 {
+        let deepest = if class < CLASSES / 2 {
             pair_range::<L, false>(view, touched, slots)
         } else {
             pair_range::<L, true>(view, touched, slots)
         };
-        breach = breach.or(found);
+        worst = worst.max(deepest);
     }
-    breach
+    worst
+}
+
+/// The run guard's report of the first contact among the pairs `slots` whose force or torque is
+/// not finite or whose overlap exceeds `view.overlap` times its smaller radius, found again from
+/// the slots and positions the pair pass left.
+///
+/// # Safety
+/// As [`pair_chunk`] for the chunks holding these pairs, after it, before their particles move.
+#[cold]
+pub(super) unsafe fn contact_breach<L: ContactLaw>(
+    view: &PairView<'_, L>,
+    arr: &Arrays<L::History>,
+    slots: impl Iterator<Item = usize>,
+) -> Option<Breach> {
+    slots.filter(|&k| arr.active.get(k)).find_map(|k| {
+        let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
+        if !finite(&arr.out.get(k)) {
+            return Some(Breach::Force { p, i });
+        }
+        let delta = overlap::<L, true>(view, p, i);
+        let limit = view.overlap * view.radius[p].min(view.radius[i]);
+        (delta > limit).then_some(Breach::Overlap { p, i, delta, limit })
+    })
 }
 
 /// Forces of a range of pairs into their slots; sets the `touched` flag of the free particles
-/// of every contact. `PERIODIC` false for interior pairs. Returns the first overlap beyond the
-/// guard's limit, if any.
+/// of every contact. `PERIODIC` false for interior pairs. Returns the largest overlap of its
+/// contacts as a fraction of their smaller radius (0 without a contact; infinite when a
+/// contact's force or torque is not finite).
 ///
 /// # Safety
 /// As [`pair_force`] for every pair of the range.
@@ -97,15 +122,20 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
     s: PairSlots<'_, L::History>,
-) -> Option<Breach> {
-    let mut breach = None;
+) -> f64 {
+    let mut worst = 0.0f64;
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
-        if let Some((delta, limit)) = pair_force::<L, PERIODIC>(view, p, i, history, active, out) {
-            breach.get_or_insert(Breach::Overlap { p, i, delta, limit });
-        }
+        pair_force::<L, PERIODIC>(view, p, i, history, active, out);
         if s.active[k] {
+            // The run guard, for contacts only: their overlap, found again from the positions.
+            let depth = overlap::<L, PERIODIC>(view, p, i) / view.radius[p].min(view.radius[i]);
+            worst = if finite(&s.out[k]) {
+                worst.max(depth)
+            } else {
+                f64::INFINITY
+            };
             // only free particles gather (and clear their flag)
             for q in [p, i] {
                 if view.inv_mass[q] > 0.0 {
@@ -114,11 +144,10 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
             }
         }
     }
-    breach
+    worst
 }
 
-/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history. Returns
-/// the overlap and its limit (length) when the overlap exceeds the guard's limit.
+/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
 ///
 /// # Safety
 /// `p` and `i` index the views, and no thread writes their positions or velocities during the
@@ -131,7 +160,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     history: &mut L::History,
     active: &mut bool,
     out: &mut PairForce,
-) -> Option<(f64, f64)> {
+) {
     let direct = view.x.get(p) - view.x.get(i);
     let r = if PERIODIC {
         view.domain.min_image(direct)
@@ -144,7 +173,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
             *active = false;
             *history = L::History::default();
         }
-        return None;
+        return;
     }
     let input = PairInput {
         r,
@@ -155,9 +184,32 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         w_p: view.w.get(p),
         w_i: view.w.get(i),
     };
-    let kin = input.kinematics()?;
-    *out = view.law.evaluate(&kin, history, view.dt);
-    *active = true;
-    let limit = view.overlap * input.rad_p.min(input.rad_i);
-    (kin.delta > limit).then_some((kin.delta, limit))
+    if let Some(kin) = input.kinematics() {
+        *out = view.law.evaluate(&kin, history, view.dt);
+        *active = true;
+    }
+}
+
+/// Whether a contact's force and torques are finite: a NaN or ±∞ component makes their sum
+/// non-finite (a force that is not finite is how a velocity would become so).
+#[inline(always)]
+fn finite(o: &PairForce) -> bool {
+    let sum = |v: Vec3| v.x + v.y + v.z;
+    (sum(o.f) + sum(o.torque_p) + sum(o.torque_i)).is_finite()
+}
+
+/// The overlap r_P + r_I − |x_P − x_I| (length) of pair (p, i); `PERIODIC` false for interior
+/// pairs, whose direct separation is their minimum image.
+///
+/// # Safety
+/// As [`pair_force`].
+#[inline(always)]
+unsafe fn overlap<L, const PERIODIC: bool>(view: &PairView<'_, L>, p: usize, i: usize) -> f64 {
+    let direct = view.x.get(p) - view.x.get(i);
+    let r = if PERIODIC {
+        view.domain.min_image(direct)
+    } else {
+        direct
+    };
+    view.radius[p] + view.radius[i] - r.norm()
 }

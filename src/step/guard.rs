@@ -1,10 +1,11 @@
 //! The run guard: checks a step makes at almost no cost, which stop a run whose numbers can no
 //! longer be trusted, naming the step, the particles, the quantity, its value and the limit.
 //!
-//! - every free particle's velocity and angular velocity after its kick is finite (checked in
-//!   the particle pass, beside the speed it computes anyway);
+//! - every contact's force and torques are finite, so that no velocity can become otherwise
+//!   (checked in the pair pass for the pairs in contact only), and every position, velocity
+//!   and angular velocity is finite at the start of each run;
 //! - no overlap exceeds a fraction of the smaller radius (checked in the pair pass for the
-//!   pairs in contact only);
+//!   pairs in contact only, and before the first step);
 //! - no free particle is outside the box along a walled axis or has a non-finite position
 //!   (checked at every pair-list rebuild, which visits every particle anyway: a particle moves
 //!   less than a skin between two rebuilds).
@@ -32,6 +33,8 @@ impl Default for GuardLimits {
 pub(super) enum Breach {
     /// A velocity (`angular` false) or angular velocity that is not finite.
     NotFinite { particle: usize, angular: bool },
+    /// A contact force or torque between particles `p` and `i` that is not finite.
+    Force { p: usize, i: usize },
     /// An overlap `delta` (length) beyond the limit between particles `p` and `i`.
     Overlap {
         p: usize,
@@ -138,6 +141,15 @@ impl Breach {
                     check the initial state for overlapping spheres, or use a smaller time step",
                 kept: None,
             },
+            Breach::Force { p, i } => Failure {
+                step,
+                time,
+                ids: ids(&[p, i]),
+                what: "the contact force or torque is not finite".to_string(),
+                remedy: "coincident spheres, or an unstable step: check the state for \
+                    overlapping spheres, or use a smaller time step",
+                kept: None,
+            },
             Breach::Overlap { p, i, delta, limit } => Failure {
                 step,
                 time,
@@ -190,5 +202,19 @@ pub(super) fn outside(
                     x,
                 })
             })
+        })
+}
+
+/// The first free particle (memory order) whose velocity or angular velocity is not finite.
+pub(super) fn not_finite(pt: &crate::state::Particles) -> Option<Breach> {
+    let finite = |v: &crate::Vec3| (v.x + v.y + v.z).is_finite();
+    (0..pt.len())
+        .filter(|&a| pt.inv_mass[a] > 0.0)
+        .find_map(|a| match (finite(&pt.v[a]), finite(&pt.w[a])) {
+            (true, true) => None,
+            (v, _) => Some(Breach::NotFinite {
+                particle: a,
+                angular: v,
+            }),
         })
 }

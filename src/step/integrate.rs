@@ -5,7 +5,6 @@
 use std::sync::atomic::Ordering;
 
 use super::arrays::Arrays;
-use super::guard::Breach;
 use crate::state::Domain;
 use crate::Vec3;
 
@@ -21,8 +20,7 @@ pub(super) struct Kick<'a> {
 /// Per-particle pass over `a..b`: with `kick_end`, gather the forces of the step that just
 /// ended and apply the closing half kick; with `drift`, apply the opening half kick and the drift
 /// of the next step. Returns the largest squared speed after the drift of a slow [0] and of a
-/// fast [1] particle (speed classes of the last build), and the first free particle whose
-/// velocity or angular velocity is not finite, if any (the run guard).
+/// fast [1] particle (speed classes of the last build).
 ///
 /// # Safety
 /// `arr` is valid (taken after the last rebuild); no other thread touches particles `a..b`
@@ -36,9 +34,8 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     b: usize,
     kick_end: bool,
     drift: bool,
-) -> ([f64; 2], Option<Breach>) {
+) -> [f64; 2] {
     let dt = k.dt;
-    let mut breach = None;
     // Four running maxima of each kind, one per lane j mod 4: a single one would chain every
     // particle's comparison to the previous one's.
     let mut vmax2 = [[0.0f64; 4]; 2];
@@ -123,13 +120,6 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
                 see(kind[j] as usize, j, vp);
             }
             v[j] = vp;
-            // The run guard: a NaN or ±∞ component makes the sum of squares non-finite.
-            if !vp.norm_squared().is_finite() {
-                breach.get_or_insert(Breach::NotFinite {
-                    particle: a + j,
-                    angular: false,
-                });
-            }
             if ROT {
                 let dw = tp * inv_inertia[j] * 0.5 * dt;
                 let mut wp = w[j];
@@ -140,12 +130,6 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
                     wp += dw;
                 }
                 w[j] = wp;
-                if !(wp.x + wp.y + wp.z).is_finite() {
-                    breach.get_or_insert(Breach::NotFinite {
-                        particle: a + j,
-                        angular: true,
-                    });
-                }
             }
         } else if drift {
             let vp = v[j];
@@ -153,10 +137,7 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
             see(kind[j] as usize, j, vp);
         }
     }
-    (
-        vmax2.map(|lanes| lanes.into_iter().fold(0.0, f64::max)),
-        breach,
-    )
+    vmax2.map(|lanes| lanes.into_iter().fold(0.0, f64::max))
 }
 
 /// Sum of the forces and torques of particle `a`'s active pairs, in the order of partner ids.

@@ -35,11 +35,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
-use self::forces::{pair_chunk, pair_force, PairView};
+use self::forces::{contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
-use crate::neighbor::rebuild::{self, gap_closed, ListState};
+use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
 use crate::state::{History, Snapshot};
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
@@ -173,12 +173,12 @@ impl<L: ContactLaw> Simulation<L> {
                 let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
                 let history = arr.history.at_mut(k);
                 let (active, out) = (arr.active.at_mut(k), arr.out.at_mut(k));
-                if let Some((delta, limit)) =
-                    pair_force::<L, true>(&view, p, i, history, active, out)
-                {
-                    let breach = guard::Breach::Overlap { p, i, delta, limit };
+                pair_force::<L, true>(&view, p, i, history, active, out);
+            }
+            if arr.active.slice(0..arr.active.len()).contains(&true) {
+                if let Some(b) = contact_breach(&view, &arr, 0..arr.p.len()) {
                     let state = &self.core.state;
-                    self.core.failure = Some(breach.report(state.step, state.time, &state.id));
+                    self.core.failure = Some(b.report(state.step, state.time, &state.id));
                 }
             }
             for a in 0..n {
@@ -196,6 +196,13 @@ impl<L: ContactLaw> Simulation<L> {
             return;
         }
         let core = &mut self.core;
+        // The run guard: velocities set since the last run are checked once here; within the
+        // run only contact forces can make them otherwise, and those are checked.
+        if let Some(b) = guard::not_finite(&core.state.particles) {
+            let state = &core.state;
+            core.failure = Some(b.report(state.step, state.time, &state.id));
+            return;
+        }
         let threads = core.params.threads;
         let chunks = core.work.plan.chunks();
         let bound = core.work.moved_bound;
@@ -323,7 +330,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             None
         };
         for s in 0..steps {
-            let speeds = self.kick_and_drift::<ROT, GRAV>(s, (s > 0).then_some(s), true);
+            let speeds = self.kick_and_drift::<ROT, GRAV>((s > 0).then_some(s), true);
             self.publish_speeds(s, speeds);
             self.meet();
             if self.team.alarm.raised() {
@@ -335,18 +342,16 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             }
             self.pair_forces(s);
         }
-        self.kick_and_drift::<ROT, GRAV>(steps, Some(steps), false);
+        self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
         (self.times, self.bound, steps)
     }
 
     /// Particle pass over the chunks this thread takes: the closing kick of step `gather` (none
     /// on the first step of a run), once every pair chunk with a pair of the chunk's particles is
     /// done, then, with `drift`, the opening kick and drift of the next. Returns the largest
-    /// squared speeds of slow [0] and fast [1] particles. A velocity that is not finite raises
-    /// the alarm for run-local step `s`.
+    /// squared speeds of slow [0] and fast [1] particles.
     fn kick_and_drift<const ROT: bool, const GRAV: bool>(
         &mut self,
-        s: u64,
         gather: Option<u64>,
         drift: bool,
     ) -> [f64; 2] {
@@ -356,7 +361,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         while let Some(c) = team.particle_queue.next(self.tid) {
             // SAFETY: a chunk is taken by one thread; its pairs' chunks are done (the wait below)
             // before it gathers; the views are current (see `Worker::rebuild`).
-            let (seen, breach) = unsafe {
+            let seen = unsafe {
                 let (a, b) = self.arr.particle_chunks.get(c);
                 if let (Some(round), true) = (gather, team.threads > 1) {
                     let (first, end) = self.arr.needs.get(c);
@@ -372,9 +377,6 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                     drift,
                 )
             };
-            if let Some(b) = breach {
-                team.alarm.raise(s, b);
-            }
             for (m, x) in v2.iter_mut().zip(seen) {
                 *m = m.max(x);
             }
@@ -481,8 +483,12 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             };
             let touched = arr.touched.slice(0..n);
             while let Some(c) = team.pair_queue.next(self.tid) {
-                if let Some(b) = pair_chunk(&view, arr, touched, c, closed) {
-                    team.alarm.raise(s, b);
+                if pair_chunk(&view, arr, touched, c, closed) > team.overlap {
+                    let (seg, ends) = (arr.pair_ranges.get(c), arr.live.get(c));
+                    let live = (0..CLASSES).flat_map(|class| seg[class]..ends[class]);
+                    if let Some(b) = contact_breach(&view, arr, live) {
+                        team.alarm.raise(s, b);
+                    }
                 }
                 team.pairs_done.set(c, s + 1);
             }
