@@ -129,13 +129,7 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
         let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
         pair_force::<L, PERIODIC>(view, p, i, history, active, out);
         if s.active[k] {
-            // The run guard, for contacts only: their overlap, found again from the positions.
-            let depth = overlap::<L, PERIODIC>(view, p, i) / view.radius[p].min(view.radius[i]);
-            worst = if finite(&s.out[k]) {
-                worst.max(depth)
-            } else {
-                f64::INFINITY
-            };
+            depth::<L, PERIODIC>(view, p, i, &s.out[k], &mut worst);
             // only free particles gather (and clear their flag)
             for q in [p, i] {
                 if view.inv_mass[q] > 0.0 {
@@ -196,6 +190,29 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
 fn finite(o: &PairForce) -> bool {
     let sum = |v: Vec3| v.x + v.y + v.z;
     (sum(o.f) + sum(o.torque_p) + sum(o.torque_i)).is_finite()
+}
+
+/// The run guard, for a contact only, out of line so that the pair loop's code stays as it is
+/// without the guard: raises `worst` to the contact's overlap as a fraction of its smaller
+/// radius (found again from the positions), or to infinity when its force or torques are not
+/// finite.
+///
+/// # Safety
+/// As [`pair_force`].
+#[inline(never)]
+unsafe fn depth<L, const PERIODIC: bool>(
+    view: &PairView<'_, L>,
+    p: usize,
+    i: usize,
+    out: &PairForce,
+    worst: &mut f64,
+) {
+    let depth = overlap::<L, PERIODIC>(view, p, i) / view.radius[p].min(view.radius[i]);
+    *worst = if finite(out) {
+        worst.max(depth)
+    } else {
+        f64::INFINITY
+    };
 }
 
 /// The overlap r_P + r_I − |x_P − x_I| (length) of pair (p, i); `PERIODIC` false for interior
