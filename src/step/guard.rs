@@ -122,14 +122,10 @@ impl Breach {
     /// The failure report of this breach at `step` and `time`, with `id` the original index of
     /// each memory index.
     pub fn report(self, step: u64, time: f64, id: &[u32]) -> Failure {
-        let ids = |a: &[usize]| a.iter().map(|&m| id[m] + 1).collect::<Vec<u32>>();
-        let axis = |k: usize| ["x", "y", "z"][k];
-        match self {
-            Breach::NotFinite { particle, angular } => Failure {
-                step,
-                time,
-                ids: ids(&[particle]),
-                what: format!(
+        let (particles, what, remedy) = match self {
+            Breach::NotFinite { particle, angular } => (
+                vec![particle],
+                format!(
                     "{} is not finite",
                     if angular {
                         "angular velocity"
@@ -137,45 +133,39 @@ impl Breach {
                         "velocity"
                     }
                 ),
-                remedy: "a force was not finite (coincident spheres, or an unstable step): \
-                    check the initial state for overlapping spheres, or use a smaller time step",
-                kept: None,
-            },
-            Breach::Force { p, i } => Failure {
-                step,
-                time,
-                ids: ids(&[p, i]),
-                what: "the contact force or torque is not finite".to_string(),
-                remedy: "coincident spheres, or an unstable step: check the state for \
-                    overlapping spheres, or use a smaller time step",
-                kept: None,
-            },
-            Breach::Overlap { p, i, delta, limit } => Failure {
-                step,
-                time,
-                ids: ids(&[p, i]),
-                what: format!(
+                "the state the run was given holds it (the step itself checks the forces that \
+                 could make one): check the initial file, or what set the velocities",
+            ),
+            Breach::Force { p, i } => (
+                vec![p, i],
+                "the contact force or torque is not finite".to_string(),
+                "coincident spheres, or an unstable step: check the state for overlapping \
+                 spheres, or use a smaller time step",
+            ),
+            Breach::Overlap { p, i, delta, limit } => (
+                vec![p, i],
+                format!(
                     "overlap {delta:e} exceeds the limit {limit:e} (guard.overlap times the \
                      smaller radius)"
                 ),
-                remedy: UNSTABLE,
-                kept: None,
-            },
-            Breach::Outside {
-                particle,
-                axis: k,
-                x,
-            } => Failure {
-                step,
-                time,
-                ids: ids(&[particle]),
-                what: format!(
+                UNSTABLE,
+            ),
+            Breach::Outside { particle, axis, x } => (
+                vec![particle],
+                format!(
                     "position {} = {x} is outside the box or not finite",
-                    axis(k)
+                    ["x", "y", "z"][axis]
                 ),
-                remedy: UNSTABLE,
-                kept: None,
-            },
+                UNSTABLE,
+            ),
+        };
+        Failure {
+            step,
+            time,
+            ids: particles.iter().map(|&m| id[m] + 1).collect(),
+            what,
+            remedy,
+            kept: None,
         }
     }
 }
