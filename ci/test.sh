@@ -5,13 +5,26 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 echo "== system packages"
-# The peers of the cross-runs and timings (Debian lammps, liggghts, with OpenMPI's mpirun) and
-# the font the profile plots label their axes with (fonts-dejavu-core).
+# The peers of the cross-runs and timings (Debian lammps, liggghts, with OpenMPI's mpirun, and
+# yade) and the font the plots label their axes with (fonts-dejavu-core).
 if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command -v mpirun >/dev/null \
+   || ! command -v yade >/dev/null \
    || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ]; then
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin fonts-dejavu-core >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin yade fonts-dejavu-core >/dev/null
 fi
+
+echo "== Python packages (virtual environment target/venv)"
+# Kratos DEM (a peer) and meshio (an independent VTK reader), pinned in ci/requirements.txt.
+# The tests find this Python through VERDEM_PYTHON.
+stamp=target/venv/requirements.sha256
+want=$(sha256sum ci/requirements.txt | cut -d' ' -f1)
+if [ ! -x target/venv/bin/python ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  python3 -m venv target/venv
+  target/venv/bin/python -m pip install -q -r ci/requirements.txt
+  echo "$want" > "$stamp"
+fi
+export VERDEM_PYTHON="$PWD/target/venv/bin/python"
 
 echo "== formatting and lints"
 cargo fmt --check
