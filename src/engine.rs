@@ -9,6 +9,7 @@ use crate::contact::{
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
+use crate::step::guard::GuardLimits;
 use crate::step::{Core, Engine, Simulation};
 use crate::Vec3;
 
@@ -87,7 +88,7 @@ struct BuildSimulation {
     builder: NeighborBuilder,
     threads: usize,
     bind: bool,
-    overlap: f64,
+    guard: GuardLimits,
 }
 
 impl LawVisitor for BuildSimulation {
@@ -103,7 +104,7 @@ impl LawVisitor for BuildSimulation {
         );
         core.state.time = self.scene.time;
         core.params.bind = self.bind;
-        core.params.guard.overlap = self.overlap;
+        core.params.guard = self.guard;
         Box::new(Simulation::new(law, core))
     }
 }
@@ -124,7 +125,10 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         builder,
         threads: o.threads.unwrap_or(case.run.threads),
         bind: o.bind.unwrap_or(true),
-        overlap: case.guard.overlap,
+        guard: GuardLimits {
+            overlap: case.guard.overlap,
+            energy: case.guard.energy,
+        },
     };
     with_law(&case.contact, parts)
 }

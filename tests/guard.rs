@@ -151,3 +151,202 @@ fn the_overlap_limit_is_read_from_the_case_and_checked() {
         "{err}"
     );
 }
+
+/// A periodic gas of 500 spheres with the benchmark's spring and no dissipation at all
+/// (γn = γt = 0, frictionless), dt = tc/`per_tc`, `steps` steps.
+fn elastic_gas(dir: &Path, per_tc: f64, steps: u64) -> String {
+    let text = std::fs::read_to_string(common::root().join("cases/verify/conservation.toml"))
+        .unwrap()
+        .replace(
+            "steps_per_collision = 50.0",
+            &format!("steps_per_collision = {per_tc}"),
+        )
+        .replace("steps = 1000000", &format!("steps = {steps}"))
+        .replace("save_every = 10000", &format!("save_every = {steps}"))
+        .replace("gamman = 15.0", "gamman = 0.0")
+        .replace("gammat = 4.285714285714286", "gammat = 0.0")
+        .replace("mu = 0.3", "mu = 0.0");
+    assert!(text.contains("gamman = 0.0") && text.contains("mu = 0.0"));
+    let path = dir.join("gas.toml");
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// At tc/dt = 2 (stable for the pair's spring alone, ω·dt = 1.57 < 2) each collision of the
+/// elastic gas returns more energy than it received: the gas heats by a quarter in 500 steps.
+/// The energy balance stops it, naming the step and the most energetic particle.
+#[test]
+fn a_gas_whose_collisions_create_energy_is_stopped_by_the_energy_balance() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = elastic_gas(dir.path(), 2.0, 2000);
+    let out = dir.path().join("out");
+    let (code, err) = run(&case, &out);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("at step 500 "), "{err}");
+    assert!(
+        err.contains("the energy of the free particles went from"),
+        "{err}"
+    );
+    assert!(
+        err.contains("a contact gave back more energy than it received"),
+        "{err}"
+    );
+    assert!(err.contains("last save ") && err.contains("conservation.data.0000"));
+    no_garbage(&out);
+}
+
+/// The same gas at tc/dt = 5 is coarse but sound: its energy stays within the scheme's
+/// truncation, and it runs to its end.
+#[test]
+fn a_coarse_but_stable_elastic_gas_runs_to_its_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = elastic_gas(dir.path(), 5.0, 3000);
+    let out = dir.path().join("out");
+    let (code, err) = run(&case, &out);
+    assert_eq!(code, Some(0), "{err}");
+    no_garbage(&out);
+}
+
+/// A wall sphere moving at 1 along x strikes a resting free sphere and sends it off at about
+/// (1 + e): the free sphere's kinetic energy comes from the wall. The balance counts the wall's
+/// work, so even a limit of 1 % of the energy at play passes; without that work the gain would
+/// be all of the sphere's final energy.
+#[test]
+fn the_work_of_a_moving_wall_is_counted_in_the_energy_balance() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = two_spheres(dir.path(), [-1.0, 0.0], [1.0, 0.0], 50.0, 2000, 1000);
+    let text = std::fs::read_to_string(&case).unwrap();
+    let fixed_first = text.replacen(
+        "v = [1, 0.0, 0.0]\n",
+        "v = [1, 0.0, 0.0]\nfixed = true\n",
+        1,
+    );
+    assert_ne!(fixed_first, text, "the first sphere is made a wall sphere");
+    std::fs::write(&case, format!("{fixed_first}[guard]\nenergy = 0.01\n")).unwrap();
+    let out = dir.path().join("out");
+    let (code, err) = run(&case, &out);
+    assert_eq!(code, Some(0), "{err}");
+    let last = std::fs::read_to_string(out.join("pair.data.0002")).unwrap();
+    let vx: f64 = last
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split_whitespace()
+        .nth(3)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(vx > 1.5, "the free sphere was struck: vx = {vx}\n{last}");
+}
+
+/// A contact law that is not dissipative (a dashpot of negative γn: restitution
+/// exp(|γn|·tc/2m_eff) = 1.11 for γn = −15) run at the benchmark's dt = tc/50, with overlaps far below the
+/// overlap limit: only the energy balance sees that every collision gives back more than it
+/// received, and it stops the run at the end of the first window. The same law with γn > 0 runs.
+#[test]
+fn a_law_that_gives_back_more_than_it_received_is_stopped() {
+    use verdem::contact::normal::LinearSpringDashpot;
+    use verdem::contact::tangential::Frictionless;
+    use verdem::contact::Composed;
+    use verdem::neighbor::NeighborBuilder;
+    use verdem::state::{Domain, Motion, Particles};
+    use verdem::step::{Core, Engine, Simulation};
+    use verdem::Vec3;
+
+    let run = |gamman: f64| {
+        let domain = Domain::new(
+            Vec3::new(-50.0, -5.0, -5.0),
+            Vec3::new(50.0, 5.0, 5.0),
+            [false; 3],
+        );
+        let mut p = Particles::default();
+        // Two unit-density spheres of diameter 1 (m = π/6), head-on at ±0.5.
+        let m = std::f64::consts::PI / 6.0;
+        for (x, v) in [(-0.505, 0.5), (0.505, -0.5)] {
+            p.push(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(v, 0.0, 0.0),
+                Vec3::zeros(),
+                0.5,
+                m,
+                Motion::Free,
+            );
+        }
+        let (kn, meff) = (2e5, 0.5 * m);
+        let tc = std::f64::consts::PI / (kn / meff).sqrt();
+        let builder = NeighborBuilder::new(0.1, 0.0, 0.5, verdem::case::Search::AllPairs);
+        let core = Core::new(domain, p, tc / 50.0, None, builder, 1);
+        let law = Composed {
+            normal: LinearSpringDashpot { kn, gamman },
+            tangential: Frictionless,
+        };
+        let mut sim = Simulation::new(law, core);
+        sim.advance(1000)
+    };
+    let failure = run(-15.0).expect_err("a law that creates energy is stopped");
+    assert!(
+        failure.what.contains("the energy of the free particles"),
+        "{failure}"
+    );
+    assert_eq!(failure.step, 500, "{failure}");
+    assert!(
+        failure.ids == vec![1] || failure.ids == vec![2],
+        "{failure}"
+    );
+    run(15.0).expect("the dissipative law runs");
+}
+
+/// A sphere falling freely under gravity with a component along a periodic axis (x, where it
+/// wraps around the box) and one along a walled axis (z): the balance counts the first as work
+/// step by step and the second as potential energy, so it closes to round-off (a limit of 1e-9
+/// of the energy at play passes). Counting either from the wrapped position would fail it.
+#[test]
+fn gravity_along_periodic_and_walled_axes_closes_the_energy_balance() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"name = "fall"
+[run]
+steps = 20000
+save_every = 10000
+steps_per_collision = 50.0
+threads = 1
+gravity = [1.0, 0.0, -1.0]
+[domain]
+lo = [0.0, 0.0, 0.0]
+hi = [10.0, 10.0, 100.0]
+periodic = [true, true, false]
+[material]
+density = 1.0
+diameter = 1.0
+[contact]
+kn = 2e5
+gamman = 15.0
+kt = 57142.857142857145
+gammat = 4.285714285714286
+mu = 0.3
+[scene]
+kind = "spheres"
+[[scene.sphere]]
+x = [9.5, 5.0, 50.0]
+[guard]
+energy = 1e-9
+"#;
+    let case = dir.path().join("fall.toml");
+    std::fs::write(&case, text).unwrap();
+    let out = dir.path().join("out");
+    let (code, err) = run(&case.display().to_string(), &out);
+    assert_eq!(code, Some(0), "{err}");
+    let last = std::fs::read_to_string(out.join("fall.data.0002")).unwrap();
+    let x: f64 = last
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        x < 9.5,
+        "the sphere wrapped around the periodic x axis: x = {x}"
+    );
+}

@@ -50,6 +50,9 @@ impl ContactLaw for AgingLaw {
             ..PairForce::default()
         }
     }
+    fn stored_energy(&self, delta: f64, _: &Aged) -> f64 {
+        0.5 * self.kn * delta * delta
+    }
 }
 
 /// Two unit spheres approaching head-on along z in a closed box.

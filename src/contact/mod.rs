@@ -122,6 +122,11 @@ pub trait ContactLaw: Send + Sync {
 
     /// Force and torques of a contact, updating its `history` over one time step `dt` (time).
     fn evaluate(&self, k: &PairKinematics, history: &mut Self::History, dt: f64) -> PairForce;
+
+    /// Elastic energy held by a contact of overlap `delta` (length, > 0) and history `history`
+    /// (energy units): what its springs can give back to the particles. The run guard's energy
+    /// balance counts it, so that a packing releasing its springs is not taken for a gain.
+    fn stored_energy(&self, delta: f64, history: &Self::History) -> f64;
 }
 
 /// A normal model and a tangential model composed into a contact law.
@@ -166,6 +171,10 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
                 torque_i: Vec3::zeros(),
             }
         }
+    }
+
+    fn stored_energy(&self, delta: f64, xi: &T::History) -> f64 {
+        self.normal.stored_energy(delta) + self.tangential.stored_energy(xi)
     }
 }
 

@@ -7,6 +7,10 @@ pub trait NormalModel: Send + Sync {
     /// The signed normal force on P along n (force units; positive repulsive) for the overlap
     /// `delta` (length, > 0) and the normal relative velocity `vn` (length/time).
     fn force(&self, delta: f64, vn: f64) -> f64;
+
+    /// Elastic energy stored at overlap `delta` (length, > 0), in energy units: what the spring
+    /// can give back; the dashpot stores none.
+    fn stored_energy(&self, delta: f64) -> f64;
 }
 
 /// Linear spring with an absolute dashpot, fn = kn·δ − γn·vn (force units; γn in mass/time,
@@ -24,6 +28,11 @@ impl NormalModel for LinearSpringDashpot {
     fn force(&self, delta: f64, vn: f64) -> f64 {
         self.kn * delta - self.gamman * vn
     }
+
+    /// ½·kn·δ², the potential of the linear spring.
+    fn stored_energy(&self, delta: f64) -> f64 {
+        0.5 * self.kn * delta * delta
+    }
 }
 
 /// Wraps a normal model and clips its attractive part: max(fn, 0).
@@ -34,6 +43,12 @@ impl<N: NormalModel> NormalModel for Clipped<N> {
     #[inline(always)]
     fn force(&self, delta: f64, vn: f64) -> f64 {
         self.0.force(delta, vn).max(0.0)
+    }
+
+    /// The wrapped model's: clipping acts on the dashpot's pull at the end of a collision,
+    /// while the spring itself still holds ½·kn·δ².
+    fn stored_energy(&self, delta: f64) -> f64 {
+        self.0.stored_energy(delta)
     }
 }
 

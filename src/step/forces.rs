@@ -26,6 +26,23 @@ pub(super) struct PairView<'a, L> {
     pub overlap: f64,
 }
 
+/// What the run guard learns from the contacts of a pass: the largest overlap as a fraction of
+/// the smaller radius (0 without a contact; infinite when a contact's force or torque is not
+/// finite), and the work the prescribed particles did on the free ones this step, in fixed point
+/// ([`super::energy::fixed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Watch {
+    pub worst: f64,
+    pub wall_work: i128,
+}
+
+impl Watch {
+    fn add(&mut self, other: Watch) {
+        self.worst = self.worst.max(other.worst);
+        self.wall_work += other.wall_work;
+    }
+}
+
 /// A range of pairs and their slots.
 pub(super) struct PairSlots<'a, H> {
     pub p: &'a [u32],
@@ -40,9 +57,8 @@ pub(super) struct PairSlots<'a, H> {
 /// [`crate::neighbor::rebuild::gap_closed`]), then the live prefix of each class is visited. A
 /// pair beyond reach cannot touch yet; its slot stays inactive, exactly as a full pass would
 /// leave it. The first `CLASSES / 2` classes hold interior pairs, whose direct separation is
-/// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns,
-/// for the run guard, the largest overlap of the chunk's contacts as a fraction of their smaller
-/// radius (0 without a contact; infinite when a contact's force or torque is not finite).
+/// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns
+/// what the run guard learns from the chunk's contacts.
 ///
 /// # Safety
 /// `arr` is valid; chunk `c` is taken by this thread alone; no thread writes the particles of
@@ -54,8 +70,8 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
     touched: &[AtomicBool],
     c: usize,
     closed: [f64; 3],
-) -> f64 {
-    let mut worst = 0.0f64;
+) -> Watch {
+    let mut watch = Watch::default();
     let seg = arr.pair_ranges.get(c);
     let ends = arr.live.at_mut(c);
     let gap = arr.gap.slice(0..arr.gap.len());
@@ -77,14 +93,14 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
             active: arr.active.slice_mut(a..b),
             out: arr.out.slice_mut(a..b),
         };
-        let deepest = if class < CLASSES / 2 {
+        let seen = if class < CLASSES / 2 {
             pair_range::<L, false>(view, touched, slots)
         } else {
             pair_range::<L, true>(view, touched, slots)
         };
-        worst = worst.max(deepest);
+        watch.add(seen);
     }
-    worst
+    watch
 }
 
 /// The run guard's report of the first contact among the pairs `slots` whose force or torque is
@@ -111,9 +127,8 @@ pub(super) unsafe fn contact_breach<L: ContactLaw>(
 }
 
 /// Forces of a range of pairs into their slots; sets the `touched` flag of the free particles
-/// of every contact. `PERIODIC` false for interior pairs. Returns the largest overlap of its
-/// contacts as a fraction of their smaller radius (0 without a contact; infinite when a
-/// contact's force or torque is not finite).
+/// of every contact. `PERIODIC` false for interior pairs. Returns what the run guard learns
+/// from its contacts.
 ///
 /// # Safety
 /// As [`pair_force`] for every pair of the range.
@@ -122,14 +137,14 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
     s: PairSlots<'_, L::History>,
-) -> f64 {
-    let mut worst = 0.0f64;
+) -> Watch {
+    let mut watch = Watch::default();
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
         pair_force::<L, PERIODIC>(view, p, i, history, active, out);
         if s.active[k] {
-            depth::<L, PERIODIC>(view, p, i, &s.out[k], &mut worst);
+            guard_contact::<L, PERIODIC>(view, p, i, &s.out[k], &mut watch);
             // only free particles gather (and clear their flag)
             for q in [p, i] {
                 if view.inv_mass[q] > 0.0 {
@@ -138,7 +153,7 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
             }
         }
     }
-    worst
+    watch
 }
 
 /// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
@@ -193,26 +208,36 @@ fn finite(o: &PairForce) -> bool {
 }
 
 /// The run guard, for a contact only, out of line so that the pair loop's code stays as it is
-/// without the guard: raises `worst` to the contact's overlap as a fraction of its smaller
+/// without the guard: raises `watch.worst` to the contact's overlap as a fraction of its smaller
 /// radius (found again from the positions), or to infinity when its force or torques are not
-/// finite.
+/// finite; and adds a wall's work on its free partner over this step, F·U·dt with F the force on
+/// the free particle and U the wall's velocity.
 ///
 /// # Safety
 /// As [`pair_force`].
 #[inline(never)]
-unsafe fn depth<L, const PERIODIC: bool>(
+unsafe fn guard_contact<L, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     p: usize,
     i: usize,
     out: &PairForce,
-    worst: &mut f64,
+    watch: &mut Watch,
 ) {
     let depth = overlap::<L, PERIODIC>(view, p, i) / view.radius[p].min(view.radius[i]);
-    *worst = if finite(out) {
-        worst.max(depth)
+    watch.worst = if finite(out) {
+        watch.worst.max(depth)
     } else {
         f64::INFINITY
     };
+    // out.f is the force on P; the force on I is −out.f.
+    let power = if view.inv_mass[p] == 0.0 {
+        -out.f.dot(&view.v.get(p))
+    } else if view.inv_mass[i] == 0.0 {
+        out.f.dot(&view.v.get(i))
+    } else {
+        return;
+    };
+    watch.wall_work += super::energy::fixed(power * view.dt);
 }
 
 /// The overlap r_P + r_I − |x_P − x_I| (length) of pair (p, i); `PERIODIC` false for interior

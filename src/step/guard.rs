@@ -18,12 +18,16 @@ use std::sync::Mutex;
 pub struct GuardLimits {
     /// Largest overlap allowed, as a fraction of the smaller radius of the pair.
     pub overlap: f64,
+    /// Largest gain of mechanical energy over a window beyond the work supplied, as a fraction
+    /// of the energy at play (see [`super::energy`]).
+    pub energy: f64,
 }
 
 impl Default for GuardLimits {
     fn default() -> Self {
         GuardLimits {
             overlap: crate::case::DEFAULT_GUARD_OVERLAP,
+            energy: crate::case::DEFAULT_GUARD_ENERGY,
         }
     }
 }
@@ -47,6 +51,16 @@ pub(super) enum Breach {
         particle: usize,
         axis: usize,
         x: f64,
+    },
+    /// The free particles' mechanical energy grew over the last `steps` steps by more than the
+    /// walls and gravity supplied; `particle` is the one of largest kinetic energy, `kinetic`
+    /// and `stored` the kinetic energy of all and the energy their contacts' springs hold.
+    Energy {
+        particle: Option<usize>,
+        steps: u64,
+        balance: super::energy::Balance,
+        kinetic: f64,
+        stored: f64,
     },
 }
 
@@ -97,14 +111,14 @@ pub struct Failure {
 impl std::fmt::Display for Failure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let ids: Vec<String> = self.ids.iter().map(u32::to_string).collect();
+        let who = match ids.len() {
+            0 => String::new(),
+            _ => format!("particle {}: ", ids.join(" and ")),
+        };
         write!(
             f,
-            "the run guard stopped the run at step {} (t = {}): particle {}: {}; {}",
-            self.step,
-            self.time,
-            ids.join(" and "),
-            self.what,
-            self.remedy
+            "the run guard stopped the run at step {} (t = {}): {who}{}; {}",
+            self.step, self.time, self.what, self.remedy
         )?;
         if let Some(kept) = &self.kept {
             write!(f, "; {kept}")?;
@@ -156,7 +170,29 @@ impl Breach {
                     "position {} = {x} is outside the box or not finite",
                     ["x", "y", "z"][axis]
                 ),
-                UNSTABLE,
+                "it passed through a wall or left an open side of the box: the explicit scheme \
+                 is likely unstable (a smaller time step, run.steps_per_collision, a softer \
+                 contact or less damping), or nothing holds it in (walls, or a larger box)",
+            ),
+            Breach::Energy {
+                particle,
+                steps,
+                balance: b,
+                kinetic,
+                stored,
+            } => (
+                particle.into_iter().collect(),
+                format!(
+                    "the energy of the free particles went from {:e} to {:e} over the last \
+                     {steps} steps (kinetic {kinetic:e}, held by contact springs {stored:e}) \
+                     while the walls and gravity supplied {:e}: a gain of {:e} beyond the limit \
+                     {:e} (guard.energy times the energy at play); the particle named has the \
+                     largest kinetic energy",
+                    b.before, b.after, b.supplied, b.gained, b.limit
+                ),
+                "a contact gave back more energy than it received: the explicit scheme is \
+                 likely unstable (a smaller time step, run.steps_per_collision, a softer contact \
+                 or less damping), or the contact law is not dissipative",
             ),
         };
         Failure {

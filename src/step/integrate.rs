@@ -15,12 +15,17 @@ pub(super) struct Kick<'a> {
     pub dt: f64,
     /// Gravity (acceleration); used only with `GRAV`.
     pub gravity: Vec3,
+    /// Its components along periodic axes, when it has any: the run guard's energy balance
+    /// counts their work m·g·Δx at every drift.
+    pub periodic_gravity: Option<Vec3>,
 }
 
 /// Per-particle pass over `a..b`: with `kick_end`, gather the forces of the step that just
 /// ended and apply the closing half kick; with `drift`, apply the opening half kick and the drift
 /// of the next step. Returns the largest squared speed after the drift of a slow [0] and of a
-/// fast [1] particle (speed classes of the last build).
+/// fast [1] particle (speed classes of the last build). With `GRAV`, adds the work of gravity
+/// along periodic axes over the drifts to `gravity_work`, in fixed point
+/// ([`super::energy::fixed`]).
 ///
 /// # Safety
 /// `arr` is valid (taken after the last rebuild); no other thread touches particles `a..b`
@@ -34,6 +39,7 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     b: usize,
     kick_end: bool,
     drift: bool,
+    gravity_work: &mut i128,
 ) -> [f64; 2] {
     let dt = k.dt;
     // Four running maxima of each kind, one per lane j mod 4: a single one would chain every
@@ -118,6 +124,9 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
                 vp += dv;
                 x[j] = drift_to(vp, x[j]);
                 see(kind[j] as usize, j, vp);
+                if let (true, Some(g)) = (GRAV, k.periodic_gravity) {
+                    *gravity_work += super::energy::fixed(g.dot(&vp) * dt / im);
+                }
             }
             v[j] = vp;
             if ROT {

@@ -26,6 +26,7 @@
 mod arrays;
 pub mod core;
 pub mod counters;
+mod energy;
 mod forces;
 pub mod guard;
 mod integrate;
@@ -120,19 +121,72 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
             self.initial_forces();
         }
-        if self.core.failure.is_none() {
-            match (L::TANGENTIAL, self.core.params.gravity.is_some()) {
-                (true, false) => self.run::<true, false>(steps),
-                (true, true) => self.run::<true, true>(steps),
-                (false, false) => self.run::<false, false>(steps),
-                (false, true) => self.run::<false, true>(steps),
+        // The steps run in windows, each closed by the run guard's energy balance.
+        let mut left = steps;
+        let mut before = self.energy();
+        while left > 0 && self.core.failure.is_none() {
+            let window = left.min(ENERGY_WINDOW);
+            let supplied = match (L::TANGENTIAL, self.core.params.gravity.is_some()) {
+                (true, false) => self.run::<true, false>(window),
+                (true, true) => self.run::<true, true>(window),
+                (false, false) => self.run::<false, false>(window),
+                (false, true) => self.run::<false, true>(window),
+            };
+            if self.core.failure.is_none() {
+                let after = self.energy();
+                self.check_balance(window, &before, &after, supplied);
+                before = after;
             }
+            left -= window;
         }
         self.core.failure.clone().map_or(Ok(()), Err)
     }
 }
 
+/// Steps of a window of the run guard's energy balance: short enough that a slow instability is
+/// stopped before a save of the benchmark (every 50000 steps), long enough that measuring the
+/// energy (a pass over the particles and the pairs) costs nothing against the steps.
+const ENERGY_WINDOW: u64 = 500;
+
 impl<L: ContactLaw> Simulation<L> {
+    /// The mechanical energy of the current state ([`energy::measure`]).
+    fn energy(&self) -> energy::Energy {
+        let c = &self.core;
+        let s = &c.state;
+        energy::measure(
+            &self.law,
+            &s.particles,
+            &s.domain,
+            c.params.gravity,
+            &c.pairs,
+        )
+    }
+
+    /// The run guard's energy balance of the `steps` steps just run, from `before` to `after`
+    /// with the work `supplied` (fixed point) of the walls and of gravity along periodic axes.
+    fn check_balance(
+        &mut self,
+        steps: u64,
+        before: &energy::Energy,
+        after: &energy::Energy,
+        supplied: i128,
+    ) {
+        let tolerance = self.core.params.guard.energy;
+        let b = energy::Balance::of(before, after, energy::float(supplied), tolerance);
+        if b.breached() {
+            let state = &mut self.core.state;
+            let breach = guard::Breach::Energy {
+                particle: after.liveliest,
+                steps,
+                balance: b,
+                kinetic: after.kinetic,
+                stored: after.stored,
+            };
+            self.core.failure = Some(breach.report(state.step, state.time, &state.id));
+            state.forces_ready = false;
+        }
+    }
+
     /// A simulation of `core` under the contact law `law`.
     pub fn new(law: L, core: Core<L::History>) -> Self {
         Simulation { law, core }
@@ -190,10 +244,11 @@ impl<L: ContactLaw> Simulation<L> {
         self.core.state.forces_ready = true;
     }
 
-    /// Advances `steps` steps on the team: every thread runs [`Worker::run`].
-    fn run<const ROT: bool, const GRAV: bool>(&mut self, steps: u64) {
+    /// Advances `steps` steps on the team: every thread runs [`Worker::run`]. Returns the work
+    /// the walls and gravity along periodic axes did on the free particles, in fixed point.
+    fn run<const ROT: bool, const GRAV: bool>(&mut self, steps: u64) -> i128 {
         if steps == 0 {
-            return;
+            return 0;
         }
         let core = &mut self.core;
         // The run guard: velocities set since the last run are checked once here; within the
@@ -201,7 +256,7 @@ impl<L: ContactLaw> Simulation<L> {
         if let Some(b) = guard::not_finite(&core.state.particles) {
             let state = &core.state;
             core.failure = Some(b.report(state.step, state.time, &state.id));
-            return;
+            return 0;
         }
         let threads = core.params.threads;
         let chunks = core.work.plan.chunks();
@@ -215,6 +270,10 @@ impl<L: ContactLaw> Simulation<L> {
         let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
         let overlap = params.guard.overlap;
         let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
+        let periodic_gravity = params
+            .gravity
+            .map(|g| energy::periodic_part(g, &domain))
+            .filter(|g| *g != Vec3::zeros());
         let mut list = core.list_state();
         let arrays = Shared::new(Arrays::of(&mut list));
         let team = Team {
@@ -238,19 +297,28 @@ impl<L: ContactLaw> Simulation<L> {
                 domain: &domain,
                 dt,
                 gravity,
+                periodic_gravity,
             },
             skin,
         };
         let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
-        let (local, bound, done) = if threads == 1 {
+        let (local, bound, done, supplied) = if threads == 1 {
             work_of(0)
         } else {
             std::thread::scope(|s| {
-                for tid in 1..threads {
-                    let work_of = &work_of;
-                    s.spawn(move || work_of(tid));
-                }
-                work_of(0)
+                let handles: Vec<_> = (1..threads)
+                    .map(|tid| {
+                        let work_of = &work_of;
+                        s.spawn(move || work_of(tid))
+                    })
+                    .collect();
+                let mine = work_of(0);
+                // Integer sums: the same in any order of the threads.
+                let others: i128 = handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)).3)
+                    .sum();
+                (mine.0, mine.1, mine.2, mine.3 + others)
             })
         };
         let breach = team.alarm.take();
@@ -267,6 +335,7 @@ impl<L: ContactLaw> Simulation<L> {
             core.failure = Some(b.report(state.step, state.time, &state.id));
             state.forces_ready = false;
         }
+        supplied
     }
 }
 
@@ -305,6 +374,9 @@ struct Worker<'t, 'a, L: ContactLaw> {
     bound: [f64; 2],
     times: StageTimes,
     laps: Laps,
+    /// Work of the walls and of gravity along periodic axes on the free particles in this
+    /// thread's passes, in fixed point (the run guard's energy balance).
+    supplied: i128,
 }
 
 impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
@@ -317,13 +389,17 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             bound,
             times: StageTimes::default(),
             laps: Laps::new(tid == 0),
+            supplied: 0,
         }
     }
 
     /// The step loop of this thread, as named stages; returns its counters, the displacement
-    /// bounds at the end and the steps completed (fewer than `steps` when the run guard stops
-    /// the run: every thread stops at the same meeting).
-    fn run<const ROT: bool, const GRAV: bool>(mut self, steps: u64) -> (StageTimes, [f64; 2], u64) {
+    /// bounds at the end, the steps completed (fewer than `steps` when the run guard stops
+    /// the run: every thread stops at the same meeting) and the work supplied in its passes.
+    fn run<const ROT: bool, const GRAV: bool>(
+        mut self,
+        steps: u64,
+    ) -> (StageTimes, [f64; 2], u64, i128) {
         let _bound = if self.team.bind {
             Bound::to_nth_cpu(self.tid, self.team.threads)
         } else {
@@ -334,7 +410,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             self.publish_speeds(s, speeds);
             self.meet();
             if self.team.alarm.raised() {
-                return (self.times, self.bound, s);
+                return (self.times, self.bound, s, self.supplied);
             }
             self.refill_queues(s);
             if self.skin_used_up(s) {
@@ -343,7 +419,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             self.pair_forces(s);
         }
         self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
-        (self.times, self.bound, steps)
+        (self.times, self.bound, steps, self.supplied)
     }
 
     /// Particle pass over the chunks this thread takes: the closing kick of step `gather` (none
@@ -375,6 +451,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                     b,
                     gather.is_some(),
                     drift,
+                    &mut self.supplied,
                 )
             };
             for (m, x) in v2.iter_mut().zip(seen) {
@@ -483,7 +560,9 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             };
             let touched = arr.touched.slice(0..n);
             while let Some(c) = team.pair_queue.next(self.tid) {
-                if pair_chunk(&view, arr, touched, c, closed) > team.overlap {
+                let watch = pair_chunk(&view, arr, touched, c, closed);
+                self.supplied += watch.wall_work;
+                if watch.worst > team.overlap {
                     let (seg, ends) = (arr.pair_ranges.get(c), arr.live.get(c));
                     let live = (0..CLASSES).flat_map(|class| seg[class]..ends[class]);
                     if let Some(b) = contact_breach(&view, arr, live) {

@@ -44,6 +44,9 @@ pub trait TangentialModel: Send + Sync {
     /// force `fn_signed` (positive repulsive), history `xi` (updated in place) and time step
     /// `dt` (time).
     fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Self::History, dt: f64) -> Vec3;
+
+    /// Elastic energy held by the tangential spring of history `xi` (energy units).
+    fn stored_energy(&self, xi: &Self::History) -> f64;
 }
 
 /// No tangential force at all (mu = 0 or no friction requested).
@@ -56,6 +59,10 @@ impl TangentialModel for Frictionless {
     #[inline(always)]
     fn force(&self, _: &PairKinematics, _: f64, _: &mut Vec3, _: f64) -> Vec3 {
         Vec3::zeros()
+    }
+
+    fn stored_energy(&self, _: &Vec3) -> f64 {
+        0.0
     }
 }
 
@@ -105,6 +112,11 @@ impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
         let skip_below = 1e-10 * fcrit / self.kt;
         U::advance(xi, slip, k, dt, skip_below);
         C::cap(xi, slip, fcrit, self.kt, self.gammat)
+    }
+
+    /// ½·kt·|ξ|²: the spring's elastic force on P is −kt·ξ.
+    fn stored_energy(&self, xi: &Vec3) -> f64 {
+        0.5 * self.kt * xi.norm_squared()
     }
 }
 

@@ -1,0 +1,192 @@
+//! The run guard's energy balance: over a window of steps, the mechanical energy of the free
+//! particles (kinetic, rotational, gravitational along walled axes, and what the contacts' springs
+//! hold) may grow by no more than the walls and gravity along periodic axes supplied.
+//!
+//! Every contact law verdem runs is passive: its springs give back at most what they took and its
+//! dashpots and sliders only take. So over any window E₁ − E₀ − W ≤ 0 in the continuous system,
+//! where W is the work of the prescribed (wall) particles on the free ones plus that of gravity
+//! along periodic axes (along walled axes gravity is in E as a potential). The explicit scheme
+//! adds a bounded error of relative size about (ω·dt)²/4 within a contact (the modified energy of
+//! Störmer–Verlet for a harmonic oscillator: Hairer, Lubich & Wanner, Geometric Numerical
+//! Integration, 2006, §I.5), and first order at contact onset; an unstable scheme, or a law that
+//! returns more energy than it received, makes the balance grow without bound.
+//!
+//! Sums are taken in fixed point ([`fixed`]): integer addition does not depend on the order of
+//! the terms, so the balance, and whether the guard stops a run, are the same for any thread
+//! count and any memory order of the particles.
+
+use crate::contact::ContactLaw;
+use crate::state::{Domain, Particles};
+use crate::Vec3;
+
+/// Scale of the fixed-point sums: 2⁶⁴ units per energy unit (resolution 5.4e-20, range ±9.2e18
+/// energy units; a term beyond the range saturates, which the guard then reports as a gain).
+const SCALE: f64 = 18446744073709551616.0;
+
+/// `x` (energy units) in fixed point. Terms below 0.5 energy units take the hardware's 64-bit
+/// conversion, the others the 128-bit one (a call); both truncate towards zero.
+#[inline]
+pub(super) fn fixed(x: f64) -> i128 {
+    let y = x * SCALE;
+    if y.abs() < 9.2e18 {
+        y as i64 as i128
+    } else {
+        y as i128
+    }
+}
+
+/// A fixed-point sum back in energy units.
+pub(super) fn float(x: i128) -> f64 {
+    x as f64 / SCALE
+}
+
+/// Gravity's components along periodic axes (acceleration): its work there is accumulated step
+/// by step; along walled axes it is a potential.
+pub(super) fn periodic_part(gravity: Vec3, domain: &Domain) -> Vec3 {
+    Vec3::from_fn(|k, _| if domain.periodic[k] { gravity[k] } else { 0.0 })
+}
+
+/// The mechanical energy of the free particles and their contacts at one moment (energy
+/// units): kinetic (with rotation), held by the contacts' springs, and gravitational along
+/// walled axes (zero at the origin); and the free particle of largest kinetic energy (memory
+/// index).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Energy {
+    pub kinetic: f64,
+    pub stored: f64,
+    pub potential: f64,
+    pub liveliest: Option<usize>,
+}
+
+/// The energy of the state: ½mv² + ½Iω² of every free particle, −m·g·x along walled axes, and
+/// the elastic energy the law's springs hold in every active contact.
+pub(super) fn measure<L: ContactLaw>(
+    law: &L,
+    pt: &Particles,
+    domain: &Domain,
+    gravity: Option<Vec3>,
+    pairs: &crate::neighbor::rebuild::Pairs<L::History>,
+) -> Energy {
+    let walled_g = gravity.map(|g| g - periodic_part(g, domain));
+    let (mut kinetic, mut potential, mut stored) = (0i128, 0i128, 0i128);
+    let mut liveliest = None;
+    let mut most = -1.0;
+    for a in (0..pt.len()).filter(|&a| pt.inv_mass[a] > 0.0) {
+        let m = 1.0 / pt.inv_mass[a];
+        // ½mv² + ½Iω², with I = 1/inv_inertia (0.4·m·r² for a solid sphere).
+        let spin = if pt.inv_inertia[a] > 0.0 {
+            0.5 * pt.w[a].norm_squared() / pt.inv_inertia[a]
+        } else {
+            0.0
+        };
+        let e = 0.5 * m * pt.v[a].norm_squared() + spin;
+        if e > most {
+            (most, liveliest) = (e, Some(a));
+        }
+        kinetic += fixed(e);
+        if let Some(g) = walled_g {
+            potential += fixed(-m * g.dot(&pt.x[a]));
+        }
+    }
+    for k in (0..pairs.active.len()).filter(|&k| pairs.active[k]) {
+        let (p, i) = (pairs.list.p[k] as usize, pairs.list.i[k] as usize);
+        let r = domain.min_image(pt.x[p] - pt.x[i]);
+        let delta = pt.radius[p] + pt.radius[i] - r.norm();
+        if delta > 0.0 {
+            stored += fixed(law.stored_energy(delta, &pairs.history[k]));
+        }
+    }
+    Energy {
+        kinetic: float(kinetic),
+        stored: float(stored),
+        potential: float(potential),
+        liveliest,
+    }
+}
+
+/// The balance of a window: `gained` = E₁ − E₀ − W (energy units) against its limit,
+/// `tolerance` times the energy at play: the mean kinetic and spring energy of the two ends plus
+/// |W| and the change of potential energy (whose zero is arbitrary). The limit is the round-off
+/// and truncation the scheme is allowed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Balance {
+    pub before: f64,
+    pub after: f64,
+    pub supplied: f64,
+    pub gained: f64,
+    pub limit: f64,
+}
+
+impl Balance {
+    /// The balance from `e0` to `e1` with work `supplied` (energy units) put in.
+    pub fn of(e0: &Energy, e1: &Energy, supplied: f64, tolerance: f64) -> Balance {
+        let (before, after) = (
+            e0.kinetic + e0.stored + e0.potential,
+            e1.kinetic + e1.stored + e1.potential,
+        );
+        let at_play = 0.5 * (e0.kinetic + e0.stored + e1.kinetic + e1.stored)
+            + supplied.abs()
+            + (e1.potential - e0.potential).abs();
+        Balance {
+            before,
+            after,
+            supplied,
+            gained: after - before - supplied,
+            limit: tolerance * at_play,
+        }
+    }
+
+    /// Whether the free particles gained more than was supplied, beyond the limit (a balance
+    /// that is not finite counts as beyond it).
+    pub fn breached(&self) -> bool {
+        !self.gained.is_finite() || !self.limit.is_finite() || self.gained > self.limit
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixed_point_sums_do_not_depend_on_the_order_of_their_terms() {
+        let terms = [0.1, 1e-12, 3.7e5, -2.5e-7, 0.3, 1e-19];
+        let forward: i128 = terms.iter().map(|&x| fixed(x)).sum();
+        let backward: i128 = terms.iter().rev().map(|&x| fixed(x)).sum();
+        assert_eq!(forward, backward);
+        let floats_fwd: f64 = terms.iter().sum();
+        assert!((float(forward) - floats_fwd).abs() <= 1e-10 * floats_fwd);
+    }
+
+    fn kinetic(k: f64) -> Energy {
+        Energy {
+            kinetic: k,
+            stored: 0.0,
+            potential: 0.0,
+            liveliest: None,
+        }
+    }
+
+    #[test]
+    fn a_gain_beyond_the_supply_breaches_and_a_loss_does_not() {
+        let b = |k0, k1, w| Balance::of(&kinetic(k0), &kinetic(k1), w, 1e-2).breached();
+        assert!(!b(10.0, 9.0, 0.5));
+        assert!(!b(10.0, 10.5, 0.5));
+        assert!(b(10.0, 11.0, 0.5));
+        assert!(b(10.0, f64::NAN, 0.5));
+        assert!(b(10.0, f64::INFINITY, 0.5));
+    }
+
+    #[test]
+    fn the_zero_of_the_potential_energy_does_not_widen_the_limit() {
+        let at = |k: f64, z: f64| Energy {
+            potential: -z,
+            ..kinetic(k)
+        };
+        // A fall of 1 turned into 1 of kinetic energy, with a gain of 0.1 beyond it, at any
+        // height: the limit is 1 % of about 2, whatever the potential's zero.
+        for z0 in [0.0, 1e6] {
+            let b = Balance::of(&at(0.0, z0), &at(1.1, z0 - 1.0), 0.0, 1e-2);
+            assert!(b.breached(), "{b:?}");
+        }
+    }
+}
