@@ -72,7 +72,7 @@ profiles = "$peer.profiles.csv, verdem_as_$peer.profiles.csv: all saves 0..$((ST
 TOML
 done
 own="$OUT/verdem_run"
-"$BIN" run cases/shear_flow.toml --init "$STATE" --steps "$STEPS" --threads 2 --out "$own" \
+"$BIN" run cases/shear_flow.toml --init "$STATE" --steps "$STEPS" --threads 2 --out "$own" --force \
   --quiet > "$OUT/verdem.log" 2>&1
 checks "$own/shear_flow" "$G/verdem.checks.txt"
 cp "$own/shear_flow.profiles.csv" "$G/verdem.profiles.csv"
