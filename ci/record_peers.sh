@@ -39,7 +39,7 @@ while IFS=$'\t' read -r name bin convention command version; do
 done <<< "$LIST"
 for peer in "${PEERS[@]}"; do
   "$BIN" cross "$peer" cases/shear_flow.toml --from "$STATE" \
-    --steps "$STEPS" --every 50000 --np 1 --out "$OUT" > "$OUT/$peer.log" 2>&1 &
+    --steps "$STEPS" --every 50000 --np 1 --out "$OUT" --force > "$OUT/$peer.log" 2>&1 &
 done
 wait
 # coarse-grains a series over all its saves (as the cross-runs do) and keeps its checks

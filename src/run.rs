@@ -215,8 +215,11 @@ pub fn run(
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
+    // What a stop leaves: the last save and checkpoint of this run.
+    let mut kept = Kept::default();
     if opts.write_saves {
-        prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)?;
+        prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)
+            .map_err(|e| kept.not_written(e, &opts.out_dir))?;
     }
     let start_step = engine.state().step;
     let mut vtk_series = match (opts.vtk && opts.write_saves, resumed) {
@@ -232,8 +235,6 @@ pub fn run(
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
-    // What a stop by the run guard leaves: the last save and checkpoint of this run.
-    let mut kept = Kept::default();
     let interrupted = loop {
         let step = engine.state().step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
@@ -241,7 +242,7 @@ pub fn run(
                 engine.advance(0).map_err(|f| kept.stopped(f))?;
             }
             let save = write_save(engine, opts, &diag, vtk_series.as_mut())
-                .map_err(|e| kept.not_written(e))?;
+                .map_err(|e| kept.not_written(e, &opts.out_dir))?;
             kept.save = Some(save);
             saves += 1;
         }
@@ -249,7 +250,7 @@ pub fn run(
             && step.is_multiple_of(opts.checkpoint_every)
             && step != start_step
         {
-            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e))?;
+            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
         }
         first = false;
@@ -261,7 +262,7 @@ pub fn run(
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed))
         {
-            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e))?;
+            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             break true;
         }
         let mut next = opts.end_step.min(step + 2000);
@@ -321,9 +322,10 @@ impl Kept {
 
     /// The error of a run stopped because a file could not be written (a full disk, a
     /// read-only folder): the file and the system's error, then what is kept on disk.
-    fn not_written(&self, e: anyhow::Error) -> anyhow::Error {
+    fn not_written(&self, e: anyhow::Error, dir: &Path) -> anyhow::Error {
         e.context(format!(
-            "the run stopped; the files written before are intact: {}",
+            "the run stopped; the files already in {} are intact ({} of this run)",
+            dir.display(),
             self.listed()
         ))
     }
