@@ -71,6 +71,8 @@ fn a_folder_holding_an_earlier_run_is_refused_and_force_replaces_it() {
         "20",
         "--save-every",
         "10",
+        "--checkpoint-every",
+        "20",
         "--quiet",
     ];
     let (code, _, err) = verdem(&[&first[..], &["--out", out]].concat());
@@ -95,15 +97,47 @@ fn a_folder_holding_an_earlier_run_is_refused_and_force_replaces_it() {
         )),
         "{err}"
     );
-    assert!(
-        err.contains("binary_collision.checks.txt") || err.contains("binary_collision.data.0000"),
-        "{err}"
-    );
+    // every file of the folder is the earlier run's, and each is counted
+    assert!(err.contains("(binary_collision."), "{err}");
+    assert!(err.contains(&format!("; {} files)", before.len())), "{err}");
     assert!(err.contains("--force"), "{err}");
     assert!(
         files(dir.path()) == before,
         "a refused run changed the folder"
     );
+
+    // a resume continues in its checkpoint's folder; into another one it is checked as a new run
+    let ck = dir.path().join("binary_collision.checkpoint");
+    let resume = [
+        "run",
+        PAIR,
+        "--steps",
+        "30",
+        "--save-every",
+        "10",
+        "--quiet",
+        "--resume",
+        ck.to_str().unwrap(),
+    ];
+    let elsewhere = tempfile::tempdir().unwrap();
+    let elsewhere = elsewhere.path().to_str().unwrap();
+    let (code, _, err) = verdem(&[&again[..], &["--out", elsewhere]].concat());
+    assert_eq!(code, Some(0), "{err}");
+    let (code, _, err) = verdem(&[&resume[..], &["--out", elsewhere]].concat());
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("already holds the files of a run"), "{err}");
+    let (code, _, err) = verdem(&[&resume[..], &["--out", out]].concat());
+    assert_eq!(code, Some(0), "{err}");
+    let resumed = files(dir.path());
+    for (name, bytes) in &before {
+        if name.contains(".data.") || name.contains(".fstat.") {
+            assert!(
+                resumed.get(name) == Some(bytes),
+                "the resume changed {name}"
+            );
+        }
+    }
+    assert!(resumed.contains_key("binary_collision.data.0003"));
 
     // another run name in the same folder is not the earlier run's
     let other = dir.path().join("other.toml");

@@ -35,8 +35,8 @@ pub struct Args {
     /// Write a checkpoint every N steps (0 = never).
     #[arg(long, default_value_t = 0)]
     checkpoint_every: u64,
-    /// Continue from a checkpoint written by --checkpoint-every (the folder then holds the
-    /// run's saves by design; saves after the checkpoint's step are written again).
+    /// Continue from a checkpoint written by --checkpoint-every (its folder holds the run's
+    /// saves by design; saves after the checkpoint's step are written again).
     #[arg(long)]
     resume: Option<PathBuf>,
     /// Replace the files of an earlier run of the same name in the output folder (without it,
@@ -79,7 +79,13 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let out_dir = a
         .out
         .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
-    if a.resume.is_none() {
+    // A resumed run continues in its checkpoint's folder, which holds its saves by design.
+    let own_folder = |ck: &PathBuf| {
+        let folder = ck.parent().filter(|d| !d.as_os_str().is_empty());
+        let canonical = |p: &Path| std::fs::canonicalize(p).ok();
+        canonical(folder.unwrap_or(Path::new("."))) == canonical(&out_dir)
+    };
+    if !a.resume.as_ref().is_some_and(own_folder) {
         let removed = run::claim_output_folder(&out_dir, &case.name, a.force, "--force")?;
         if removed > 0 {
             println!(
