@@ -279,3 +279,38 @@ fn verdem_vtk_converts_mercurydpm_saves() {
     assert_eq!(series.len(), 1);
     assert_eq!(series[0].1, "Mercury_out.0000.vtu");
 }
+
+/// A resumed run keeps the saves before its checkpoint in the `.pvd` and adds its own.
+#[test]
+fn a_resumed_run_continues_the_time_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let name = "shear_flow_steady";
+    let args = [
+        "run",
+        "cases/shear_flow_steady.toml",
+        "--save-every",
+        "10",
+        "--vtk",
+        "--quiet",
+        "--out",
+        out,
+    ];
+    common::verdem_ok([&args[..], &["--steps", "10", "--checkpoint-every", "10"]].concat());
+    let ck = dir.path().join(format!("{name}.checkpoint"));
+    common::verdem_ok(
+        [
+            &args[..],
+            &["--steps", "20", "--resume", ck.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let times: Vec<(f64, String)> = (0..3)
+        .map(|k| {
+            same_as_the_save(dir.path(), name, k);
+            let data = read_data(&save_path(dir.path(), name, "data", k)).unwrap();
+            (data.time, format!("{name}.{k:04}.vtu"))
+        })
+        .collect();
+    assert_eq!(collection(&dir.path().join(format!("{name}.pvd"))), times);
+}
