@@ -110,9 +110,10 @@ pub fn saves_of(dir: &Path, name: &str) -> anyhow::Result<Vec<u64>> {
         .iter()
         .filter_map(|p| {
             let file = p.file_name()?.to_str()?;
-            let k = file.strip_prefix(&format!("{name}.data."))?;
-            let fstat = mercury::save_path(dir, name, "fstat", k.parse().ok()?);
-            fstat.exists().then(|| k.parse().ok())?
+            let k: u64 = file.strip_prefix(&format!("{name}.data."))?.parse().ok()?;
+            mercury::save_path(dir, name, "fstat", k)
+                .exists()
+                .then_some(k)
         })
         .collect();
     saves.sort_unstable();

@@ -182,7 +182,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
 }
 
 /// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has
-/// no save); the wall spheres are the state's prescribed ones (in id order, as the save). Returns the picture's path.
+/// no save); the wall spheres are the state's prescribed ones (in id order, as the save).
+/// Returns the picture's path.
 fn particles_picture(opts: &RunOptions, engine: &dyn Engine) -> anyhow::Result<Option<PathBuf>> {
     let Some(&k) = run::saves_of(&opts.out_dir, &opts.name)?.last() else {
         return Ok(None);
