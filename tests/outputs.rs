@@ -396,3 +396,33 @@ fn the_particles_picture_shows_the_shear_flow() {
         .count();
     assert!(grey > 10_000, "{grey} grey pixels");
 }
+
+/// `verdem cross` and `verdem tradeoff` write saves too: a folder of theirs that holds an
+/// earlier run's saves is refused before any peer or variant runs.
+#[test]
+fn cross_and_tradeoff_refuse_an_earlier_runs_saves() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let earlier = |sub: &str| {
+        let folder = dir.path().join(sub);
+        std::fs::create_dir_all(&folder).unwrap();
+        let save = folder.join("shear_flow_quick.data.0000");
+        std::fs::write(&save, "earlier\n").unwrap();
+        save
+    };
+    for (args, sub) in [
+        (vec!["cross", "lammps", "--out", out], "lmp/verdem"),
+        (vec!["tradeoff", "--out", out], "reference"),
+    ] {
+        let save = earlier(sub);
+        let (code, _, err) = verdem(&args);
+        assert_eq!(code, Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("already holds the files of a run named \"shear_flow_quick\""),
+            "{args:?}: {err}"
+        );
+        assert!(err.contains("--force"), "{err}");
+        assert_eq!(std::fs::read_to_string(&save).unwrap(), "earlier\n");
+        std::fs::remove_file(save).unwrap();
+    }
+}
