@@ -216,10 +216,10 @@ pub fn vtu_text(frame: &Frame) -> String {
     s.push_str("<?xml version=\"1.0\"?>\n");
     s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
     s.push_str("  <UnstructuredGrid>\n    <FieldData>\n");
-    array(&mut s, "Float64", "TimeValue", 1, &[frame.time], |t, o| {
-        o.push(*t)
-    });
-    s.push_str("    </FieldData>\n");
+    // field arrays need their tuple count (VTK's XML reader skips a field array without it)
+    s.push_str("        <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">\n          ");
+    fmt_f64(&mut s, frame.time);
+    s.push_str("\n        </DataArray>\n    </FieldData>\n");
     s.push_str(&format!(
         "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{}\">\n",
         cells.len()
