@@ -1,7 +1,8 @@
 //! ParaView output read back by an independent reader (Python's meshio, in the virtual
 //! environment `ci/test.sh` makes; its Python is VERDEM_PYTHON) and compared with the MercuryCG
 //! save it shows: positions, radii, velocities and spins bit for bit, the wall spheres, and one
-//! line per contact of the `.fstat` carrying its normal and tangential force.
+//! line per contact of the `.fstat` carrying its normal and tangential force. A run's `.pvd` is
+//! also opened by ParaView's own reader.
 
 mod common;
 
@@ -171,6 +172,76 @@ fn same_as_the_save(dir: &Path, name: &str, k: u64) -> usize {
     pairs.len()
 }
 
+/// Opens `dir/name.pvd` with ParaView's own reader (Debian's `python3-paraview`, which
+/// `ci/test.sh` installs): its time steps are the saves' times, and its last step has every
+/// particle as a point and a vertex, and every contact of that save as a line.
+fn opens_in_paraview(dir: &Path, name: &str, saves: u64) {
+    const OPEN_PVD: &str = r#"
+import sys
+try:
+    from paraview.simple import PVDReader
+except ImportError as e:
+    sys.exit(f"ParaView's Python module is missing ({e}): apt-get install python3-paraview")
+r = PVDReader(FileName=sys.argv[1])
+print("times", " ".join(repr(t) for t in r.TimestepValues))
+r.UpdatePipeline(r.TimestepValues[-1])
+d = r.GetDataInformation()
+print("points", d.GetNumberOfPoints())
+print("cells", d.GetNumberOfCells())
+print("point_arrays", " ".join(sorted(r.PointData.keys())))
+print("cell_arrays", " ".join(sorted(r.CellData.keys())))
+"#;
+    let pvd = dir.join(format!("{name}.pvd"));
+    let o = Command::new("/usr/bin/python3")
+        .args(["-c", OPEN_PVD])
+        .arg(&pvd)
+        .output()
+        .expect("/usr/bin/python3 runs");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{}: {}{text}",
+        pvd.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let field = |key: &str| {
+        text.lines()
+            .find_map(|l| l.strip_prefix(key).map(|v| v.trim().to_string()))
+            .unwrap_or_else(|| panic!("no {key} in {text}"))
+    };
+    let times: Vec<f64> = (0..saves)
+        .map(|k| read_data(&save_path(dir, name, "data", k)).unwrap().time)
+        .collect();
+    let read: Vec<f64> = field("times ")
+        .split(' ')
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!(read, times);
+    let last = saves - 1;
+    let n = read_data(&save_path(dir, name, "data", last))
+        .unwrap()
+        .rows
+        .len();
+    let mut pairs: Vec<(usize, usize)> = read_fstat(&save_path(dir, name, "fstat", last))
+        .unwrap()
+        .rows
+        .iter()
+        .map(|r| (r.i.min(r.j), r.i.max(r.j)))
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    assert_eq!(field("points "), n.to_string());
+    assert_eq!(field("cells "), (n + pairs.len()).to_string());
+    assert_eq!(
+        field("point_arrays "),
+        "angular_velocity id radius velocity wall"
+    );
+    assert_eq!(
+        field("cell_arrays "),
+        "normal_force periodic tangential_force"
+    );
+}
+
 /// The `.pvd`'s data sets: (time, file).
 fn collection(pvd: &Path) -> Vec<(f64, String)> {
     run_python(READ_PVD, pvd)
@@ -201,6 +272,7 @@ fn a_run_with_vtk_reads_back_as_its_saves() {
     let name = "shear_flow_steady";
     let contacts: usize = (0..3).map(|k| same_as_the_save(dir.path(), name, k)).sum();
     assert!(contacts > 0, "the steady flow has contacts");
+    opens_in_paraview(dir.path(), name, 3);
     let series = collection(&dir.path().join(format!("{name}.pvd")));
     let times: Vec<(f64, String)> = (0..3)
         .map(|k| {
