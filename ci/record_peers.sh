@@ -39,7 +39,7 @@ while IFS=$'\t' read -r name bin convention command version; do
 done <<< "$LIST"
 for peer in "${PEERS[@]}"; do
   "$BIN" cross "$peer" cases/shear_flow.toml --from "$STATE" \
-    --steps "$STEPS" --every 50000 --np 1 --out "$OUT" > "$OUT/$peer.log" 2>&1 &
+    --steps "$STEPS" --every 50000 --np 1 --out "$OUT" --force > "$OUT/$peer.log" 2>&1 &
 done
 wait
 # coarse-grains a series over all its saves (as the cross-runs do) and keeps its checks
@@ -72,7 +72,7 @@ profiles = "$peer.profiles.csv, verdem_as_$peer.profiles.csv: all saves 0..$((ST
 TOML
 done
 own="$OUT/verdem_run"
-"$BIN" run cases/shear_flow.toml --init "$STATE" --steps "$STEPS" --threads 2 --out "$own" \
+"$BIN" run cases/shear_flow.toml --init "$STATE" --steps "$STEPS" --threads 2 --out "$own" --force \
   --quiet > "$OUT/verdem.log" 2>&1
 checks "$own/shear_flow" "$G/verdem.checks.txt"
 cp "$own/shear_flow.profiles.csv" "$G/verdem.profiles.csv"

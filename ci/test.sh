@@ -6,12 +6,14 @@ cd "$(dirname "$0")/.."
 
 echo "== system packages"
 # The peers of the cross-runs and timings (Debian lammps, liggghts, with OpenMPI's mpirun, and
-# yade) and the font the plots label their axes with (fonts-dejavu-core).
+# yade), the font the plots label their axes with (fonts-dejavu-core), and ParaView's Python
+# module (python3-paraview), whose reader opens a run's VTK files in tests/vtk.rs.
 if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command -v mpirun >/dev/null \
    || ! command -v yade >/dev/null \
-   || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ]; then
+   || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] \
+   || [ ! -f /usr/lib/python3/dist-packages/paraview/simple.py ]; then
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin yade fonts-dejavu-core >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin yade fonts-dejavu-core python3-paraview >/dev/null
 fi
 
 echo "== Python packages (virtual environment target/venv)"

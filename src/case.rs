@@ -32,6 +32,8 @@ pub struct Case {
     pub scene: Scene,
     #[serde(default)]
     pub guard: Guard,
+    #[serde(default)]
+    pub output: Output,
     /// Directory the case was read from (relative paths in the case resolve against it).
     #[serde(skip)]
     pub dir: PathBuf,
@@ -128,6 +130,15 @@ impl Default for Guard {
             energy: DEFAULT_GUARD_ENERGY,
         }
     }
+}
+
+/// `[output]`: files a run writes beside its MercuryCG saves.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Also write each save as a ParaView file (`NAME.NNNN.vtu`, listed in `NAME.pvd`).
+    #[serde(default)]
+    pub vtk: bool,
 }
 
 /// How candidate pairs are found.

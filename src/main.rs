@@ -49,6 +49,9 @@ enum Command {
     Kinematics(cli::kinematics::Args),
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash(cli::hash::Args),
+    /// Convert a MercuryCG series (verdem's or a peer's) into ParaView files: NAME.NNNN.vtu per
+    /// save (particles and contact lines) and the NAME.pvd time series.
+    Vtk(cli::vtk::Args),
 }
 
 fn main() {
@@ -63,6 +66,7 @@ fn main() {
         Command::Tradeoff(a) => cli::tradeoff::exec(a),
         Command::Kinematics(a) => cli::kinematics::exec(a),
         Command::Hash(a) => cli::hash::exec(a),
+        Command::Vtk(a) => cli::vtk::exec(a),
     };
     match outcome {
         Ok(Finished::Done) => {}

@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
-use crate::io::{atomic, csv_table, mercury};
+use crate::io::{atomic, csv_table, mercury, vtk};
 use crate::step::{Engine, StageTimes};
 
 /// Options of one run.
@@ -28,6 +28,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Write `.data`/`.fstat` saves and diagnostics (false for timing runs).
     pub write_saves: bool,
+    /// Also write each save as a ParaView file ([`crate::io::vtk`]).
+    pub vtk: bool,
     /// A request to stop (set by a signal handler): the run stops at the end of the block of
     /// steps under way (at most 2000), writes a checkpoint there and returns.
     pub stop: Option<Arc<AtomicBool>>,
@@ -93,13 +95,116 @@ pub fn write_summary(
     threads: usize,
 ) -> anyhow::Result<()> {
     let p = summary_path(dir, name);
-    atomic::write(&p, summary.toml(name, threads).as_bytes())
-        .with_context(|| p.display().to_string())
+    Ok(atomic::write(&p, summary.toml(name, threads).as_bytes())?)
 }
 
 /// Path of the run's checkpoint.
 pub fn checkpoint_path(dir: &Path, name: &str) -> PathBuf {
     dir.join(format!("{name}.checkpoint"))
+}
+
+/// The save numbers of the series `dir/name` that have both a `.data` and a `.fstat` file,
+/// increasing (none when the folder does not exist).
+pub fn saves_of(dir: &Path, name: &str) -> anyhow::Result<Vec<u64>> {
+    let mut saves: Vec<u64> = run_files(dir, name)?
+        .iter()
+        .filter_map(|p| {
+            let file = p.file_name()?.to_str()?;
+            let k: u64 = file.strip_prefix(&format!("{name}.data."))?.parse().ok()?;
+            mercury::save_path(dir, name, "fstat", k)
+                .exists()
+                .then_some(k)
+        })
+        .collect();
+    saves.sort_unstable();
+    Ok(saves)
+}
+
+/// The files of the run `name` in `dir`, sorted: its saves (`NAME.data.NNNN`, `NAME.fstat.NNNN`,
+/// `NAME.NNNN.vtu`, `NAME.pvd`), checkpoint, diagnostics, summary, profiles, checks and
+/// pictures. Files of runs with other names are not among them.
+pub fn run_files(dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(Vec::new());
+    };
+    let numbered = |s: &str| s.len() >= 4 && s.bytes().all(|b| b.is_ascii_digit());
+    let prefix = format!("{name}.");
+    let mut found = Vec::new();
+    for entry in entries {
+        let entry = entry.with_context(|| format!("{}: cannot list", dir.display()))?;
+        let file = entry.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let ours = match rest.split_once('.') {
+            Some(("data" | "fstat", k)) => numbered(k),
+            Some((k, "vtu")) => numbered(k),
+            _ => OWN_FILES.contains(&rest),
+        };
+        if ours {
+            found.push(entry.path());
+        }
+    }
+    found.sort();
+    Ok(found)
+}
+
+/// The files of a run besides its numbered saves, after `NAME.`.
+const OWN_FILES: [&str; 9] = [
+    "pvd",
+    "checkpoint",
+    "diagnostics.csv",
+    "summary.toml",
+    "profiles.csv",
+    "profiles.png",
+    "checks.txt",
+    "particles.png",
+    "profiles.part.png",
+];
+
+/// Makes `dir` ready for a new run named `name`: a folder that holds the files of an earlier
+/// run of that name ([`run_files`]) is refused, naming the folder and the files, unless `force`
+/// is set; then those files are removed first (so no save of the earlier run is mistaken for
+/// one of the new run). `flag` is the option that sets `force` (for the message). Returns the
+/// number of files removed.
+pub fn claim_output_folder(
+    dir: &Path,
+    name: &str,
+    force: bool,
+    flag: &str,
+) -> anyhow::Result<usize> {
+    let found = run_files(dir, name)?;
+    if found.is_empty() {
+        return Ok(0);
+    }
+    if !force {
+        let shown: Vec<String> = found
+            .iter()
+            .take(4)
+            .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into_owned()))
+            .collect();
+        let more = match found.len() - shown.len() {
+            0 => String::new(),
+            m => format!(" and {m} more"),
+        };
+        bail!(
+            "{}: already holds the files of a run named {name:?} ({}{more}; {} files); nothing \
+             was written. Choose another output folder, continue that run with --resume \
+             CHECKPOINT, or replace its files with {flag}",
+            dir.display(),
+            shown.join(", "),
+            found.len()
+        );
+    }
+    for p in &found {
+        std::fs::remove_file(p).with_context(|| {
+            format!(
+                "{}: cannot remove (replacing the files of an earlier run, {flag})",
+                p.display()
+            )
+        })?;
+    }
+    Ok(found.len())
 }
 
 /// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists.
@@ -111,30 +216,42 @@ pub fn run(
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
+    // What a stop leaves: the last save and checkpoint of this run.
+    let mut kept = Kept::default();
     if opts.write_saves {
-        prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)?;
+        prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)
+            .map_err(|e| kept.not_written(e, &opts.out_dir))?;
     }
     let start_step = engine.state().step;
+    let mut vtk_series = match (opts.vtk && opts.write_saves, resumed) {
+        (false, _) => None,
+        (true, false) => Some(vtk::Series::new(&opts.out_dir, &opts.name)),
+        (true, true) => Some(vtk::Series::resume(
+            &opts.out_dir,
+            &opts.name,
+            start_step / opts.save_every,
+        )?),
+    };
     let bar = progress_bar(opts, start_step);
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
-    // What a stop by the run guard leaves: the last save and checkpoint of this run.
-    let mut kept = Kept::default();
     let interrupted = loop {
         let step = engine.state().step;
         if opts.write_saves && step.is_multiple_of(opts.save_every) && !(first && resumed) {
             if !engine.state().forces_ready {
                 engine.advance(0).map_err(|f| kept.stopped(f))?;
             }
-            kept.save = Some(write_save(engine, opts, &diag)?);
+            let save = write_save(engine, opts, &diag, vtk_series.as_mut())
+                .map_err(|e| kept.not_written(e, &opts.out_dir))?;
+            kept.save = Some(save);
             saves += 1;
         }
         if opts.checkpoint_every > 0
             && step.is_multiple_of(opts.checkpoint_every)
             && step != start_step
         {
-            write_checkpoint(engine, opts)?;
+            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
         }
         first = false;
@@ -146,7 +263,7 @@ pub fn run(
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed))
         {
-            write_checkpoint(engine, opts)?;
+            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             break true;
         }
         let mut next = opts.end_step.min(step + 2000);
@@ -197,31 +314,69 @@ struct Kept {
 impl Kept {
     /// The error of a run stopped by the run guard: its failure and what is kept on disk.
     fn stopped(&self, mut f: crate::step::guard::Failure) -> anyhow::Error {
+        f.kept = Some(format!(
+            "nothing was written after the last good state: {}",
+            self.listed()
+        ));
+        anyhow::Error::new(f)
+    }
+
+    /// The error of a run stopped because a file could not be written (a full disk, a
+    /// read-only folder): the file and the system's error, then what is kept on disk.
+    fn not_written(&self, e: anyhow::Error, dir: &Path) -> anyhow::Error {
+        e.context(format!(
+            "the run stopped; the files already in {} are intact ({} of this run)",
+            dir.display(),
+            self.listed()
+        ))
+    }
+
+    fn listed(&self) -> String {
         let name = |p: &Option<PathBuf>| {
             p.as_ref()
                 .map_or("none".to_string(), |p| p.display().to_string())
         };
-        f.kept = Some(format!(
-            "nothing was written after the last good state: last save {}, last checkpoint {}",
+        format!(
+            "last save {}, last checkpoint {}",
             name(&self.save),
             name(&self.checkpoint)
-        ));
-        anyhow::Error::new(f)
+        )
     }
 }
 
-/// Writes the save of the current step; returns the path of its `.data` file.
-fn write_save(engine: &dyn Engine, opts: &RunOptions, diag: &Path) -> anyhow::Result<PathBuf> {
+/// Writes the save of the current step (`.data`, `.fstat`, the `.vtu` when asked, then its
+/// diagnostics row); returns the path of its `.data` file. A save that cannot be written whole
+/// is removed, so the folder holds whole saves only.
+fn write_save(
+    engine: &dyn Engine,
+    opts: &RunOptions,
+    diag: &Path,
+    vtk_series: Option<&mut vtk::Series>,
+) -> anyhow::Result<PathBuf> {
     let core = &engine.snapshot();
     let k = core.step / opts.save_every;
     let data = mercury::save_path(&opts.out_dir, &opts.name, "data", k);
-    atomic::write(&data, mercury::data_text(core).as_bytes())
-        .with_context(|| format!("{}: cannot write", data.display()))?;
     let fstat = mercury::save_path(&opts.out_dir, &opts.name, "fstat", k);
-    atomic::write(&fstat, mercury::fstat_text(core).as_bytes())
-        .with_context(|| format!("{}: cannot write", fstat.display()))?;
-    atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())
-        .with_context(|| format!("{}: cannot append", diag.display()))?;
+    // the files of this save replaced so far: removed again if the save cannot be completed
+    let mut replaced: Vec<PathBuf> = Vec::new();
+    let written = (|| {
+        atomic::write(&data, mercury::data_text(core).as_bytes())?;
+        replaced.push(data.clone());
+        atomic::write(&fstat, mercury::fstat_text(core).as_bytes())?;
+        replaced.push(fstat.clone());
+        if let Some(series) = vtk_series {
+            replaced.push(series.write(k, &vtk::Frame::of_snapshot(core))?);
+        }
+        atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())
+    })();
+    if let Err(e) = written {
+        for p in &replaced {
+            let _ = std::fs::remove_file(p);
+        }
+        return Err(
+            anyhow::Error::new(e).context(format!("save {k} (step {}) was not written", core.step))
+        );
+    }
     Ok(data)
 }
 
@@ -263,7 +418,7 @@ fn prepare_diagnostics(
         }
     }
     let text = kept.into_inner()?;
-    atomic::write(path, &text).with_context(|| format!("{}: cannot write", path.display()))
+    Ok(atomic::write(path, &text)?)
 }
 
 fn progress_bar(opts: &RunOptions, start: u64) -> Option<indicatif::ProgressBar> {

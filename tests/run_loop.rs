@@ -17,6 +17,7 @@ fn options(dir: &std::path::Path, end: u64, checkpoint_every: u64) -> RunOptions
         tag: "q:3480".into(),
         progress: false,
         write_saves: true,
+        vtk: false,
         stop: None,
     }
 }

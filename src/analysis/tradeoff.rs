@@ -159,6 +159,7 @@ pub fn run(
                 tag: v.name.clone(),
                 progress: false,
                 write_saves: true,
+                vtk: false,
                 stop: None,
             },
             false,

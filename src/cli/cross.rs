@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use verdem::case::{Case, Tangential};
 use verdem::peers::{cross, Peer};
+use verdem::run;
 
 use super::args::{count, described};
 use super::Finished;
@@ -37,11 +38,18 @@ pub struct Args {
         value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
     )]
     convention: Option<Tangential>,
+    /// Replace the saves of an earlier cross-run in OUT/PEER (without it, such a folder is
+    /// refused and nothing is written).
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let case = Case::load(&a.case)?;
     let out = a.out.join(a.peer.binary());
+    for series in [a.peer.binary(), "verdem"] {
+        run::claim_output_folder(&out.join(series), &case.name, a.force, "--force")?;
+    }
     let convention = a.convention.unwrap_or(a.peer.convention());
     let report = cross::cross(
         a.peer, &case, convention, &a.from, a.steps, a.every, a.np, &out,

@@ -12,6 +12,7 @@ pub mod peers;
 pub mod run;
 pub mod tradeoff;
 pub mod verify;
+pub mod vtk;
 
 /// Exit status of a run stopped by a signal after writing its checkpoint (128 + SIGINT, as a
 /// shell reports a process that SIGINT ended).

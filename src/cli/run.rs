@@ -8,9 +8,13 @@ use std::sync::Arc;
 use anyhow::Context;
 
 use verdem::analysis::cg::{self, CgOptions};
+use verdem::analysis::particles;
 use verdem::case::{Case, Scene};
-use verdem::io::checkpoint;
+use verdem::io::vtk::Particle;
+use verdem::io::{checkpoint, mercury};
 use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
+use verdem::state::Motion;
+use verdem::step::Engine;
 
 use super::args::{count, Common};
 use super::{Finished, EXIT_INTERRUPTED};
@@ -31,9 +35,18 @@ pub struct Args {
     /// Write a checkpoint every N steps (0 = never).
     #[arg(long, default_value_t = 0)]
     checkpoint_every: u64,
-    /// Continue from a checkpoint written by --checkpoint-every.
+    /// Continue from a checkpoint written by --checkpoint-every (its folder holds the run's
+    /// saves by design; saves after the checkpoint's step are written again).
     #[arg(long)]
     resume: Option<PathBuf>,
+    /// Replace the files of an earlier run of the same name in the output folder (without it,
+    /// such a folder is refused and nothing is written).
+    #[arg(long)]
+    force: bool,
+    /// Also write each save as a ParaView file, NAME.NNNN.vtu, listed in NAME.pvd (as
+    /// `[output] vtk = true` in the case).
+    #[arg(long)]
+    vtk: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -63,17 +76,35 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             engine.state().step
         );
     }
+    let out_dir = a
+        .out
+        .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
+    // A resumed run continues in its checkpoint's folder, which holds its saves by design.
+    let own_folder = |ck: &PathBuf| {
+        let folder = ck.parent().filter(|d| !d.as_os_str().is_empty());
+        let canonical = |p: &Path| std::fs::canonicalize(p).ok();
+        canonical(folder.unwrap_or(Path::new("."))) == canonical(&out_dir)
+    };
+    if !a.resume.as_ref().is_some_and(own_folder) {
+        let removed = run::claim_output_folder(&out_dir, &case.name, a.force, "--force")?;
+        if removed > 0 {
+            println!(
+                "removed the {removed} files of an earlier run {:?} from {} (--force)",
+                case.name,
+                out_dir.display()
+            );
+        }
+    }
     let opts = RunOptions {
         end_step,
         save_every: a.save_every.unwrap_or(case.run.save_every),
         checkpoint_every: a.checkpoint_every,
-        out_dir: a
-            .out
-            .unwrap_or_else(|| PathBuf::from("out").join(&case.name)),
+        out_dir,
         name: case.name.clone(),
         tag,
         progress: !a.quiet,
         write_saves: true,
+        vtk: a.vtk || case.output.vtk,
         stop: Some(stop_on_signal()?),
     };
     let s = run::run(engine.as_mut(), &opts, a.resume.is_some())?;
@@ -128,6 +159,9 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     );
     println!("state hash: {}", s.hash);
     run::write_summary(&opts.out_dir, &case.name, &s, threads)?;
+    if let Some(png) = particles_picture(&opts, engine.as_ref())? {
+        println!("particles: {}", png.display());
+    }
     if s.saves > 0 && shear {
         let (_, report) =
             cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
@@ -145,6 +179,36 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         );
     }
     Ok(Finished::Done)
+}
+
+/// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has
+/// no save); the wall spheres are the state's prescribed ones (in id order, as the save).
+/// Returns the picture's path.
+fn particles_picture(opts: &RunOptions, engine: &dyn Engine) -> anyhow::Result<Option<PathBuf>> {
+    let Some(&k) = run::saves_of(&opts.out_dir, &opts.name)?.last() else {
+        return Ok(None);
+    };
+    let data = mercury::read_data(&mercury::save_path(&opts.out_dir, &opts.name, "data", k))?;
+    let motion = engine.snapshot().particles.motion;
+    let particles: Vec<Particle> = data
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(a, r)| Particle {
+            x: r.x,
+            v: r.v,
+            w: r.w,
+            radius: r.radius,
+            wall: motion.get(a).is_some_and(|m| *m != Motion::Free),
+        })
+        .collect();
+    let png = opts.out_dir.join(format!("{}.particles.png", opts.name));
+    let title = format!(
+        "{}: save {k}, t = {:.3}; side view (x, z), colour vx",
+        opts.name, data.time
+    );
+    particles::particles_png(&particles, &data.domain_lo, &data.domain_hi, &title, &png)?;
+    Ok(Some(png))
 }
 
 /// Prints the derived contact numbers so a user sees at once whether a contact is resolved.

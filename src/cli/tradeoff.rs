@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use verdem::analysis::tradeoff;
 use verdem::case::Case;
 use verdem::io::atomic;
+use verdem::run;
 
 use super::args::{count, positive};
 use super::Finished;
@@ -28,11 +29,18 @@ pub struct Args {
     /// The two-sphere case whose restitution each variant's law is measured on.
     #[arg(long, default_value = "cases/verify/binary_collision.toml")]
     pair: PathBuf,
+    /// Replace the saves of an earlier tradeoff in OUT's variant folders (without it, such a
+    /// folder is refused and nothing is written).
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let case = Case::load(&a.case)?;
     let pair = Case::load(&a.pair)?;
+    for variant in std::fs::read_dir(&a.out).into_iter().flatten().flatten() {
+        run::claim_output_folder(&variant.path(), &case.name, a.force, "--force")?;
+    }
     let outcomes = tradeoff::run(&case, &pair, &a.from, a.time, a.saves, &a.out)?;
     let table = tradeoff::markdown(&outcomes);
     atomic::write(&a.out.join("tradeoff.md"), table.as_bytes())?;

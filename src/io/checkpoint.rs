@@ -48,8 +48,7 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
     }
-    crate::io::atomic::write(path, &b)
-        .with_context(|| format!("{}: cannot write checkpoint", path.display()))
+    Ok(crate::io::atomic::write(path, &b)?)
 }
 
 struct Reader<'a> {

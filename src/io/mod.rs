@@ -1,5 +1,5 @@
 //! Files: MercuryCG `.data`/`.fstat` saves, the official initial-configuration format,
-//! checkpoints, the state hash, the diagnostics table, atomic writes.
+//! checkpoints, the state hash, the diagnostics table, ParaView's VTK files, atomic writes.
 
 pub mod atomic;
 pub mod checkpoint;
@@ -8,6 +8,7 @@ pub mod diagnostics;
 pub mod hash;
 pub mod mercury;
 pub mod official;
+pub mod vtk;
 
 /// A malformed input file: `file:line: message`.
 #[derive(Debug, thiserror::Error)]

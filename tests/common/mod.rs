@@ -72,6 +72,7 @@ pub fn run_with_saves(
         tag: name.into(),
         progress: false,
         write_saves: true,
+        vtk: false,
         stop: None,
     };
     verdem::run::run(engine, &opts, false).expect("run")

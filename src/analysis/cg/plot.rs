@@ -11,7 +11,8 @@ use super::{Profiles, COLUMNS};
 /// The TrueType font used for labels (Debian package `fonts-dejavu-core`).
 pub const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-fn register_font() -> anyhow::Result<()> {
+/// Registers [`FONT`] as plotters' "sans-serif" (once per process).
+pub fn register_font() -> anyhow::Result<()> {
     static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
     DONE.get_or_init(|| {
         let bytes = std::fs::read(FONT)
