@@ -353,3 +353,80 @@ impl Peer for Yade {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::Domain;
+
+    /// Two spheres touching along x, sphere 1 at the origin and sphere 0 at x = 0.99.
+    fn pair() -> Snapshot {
+        let case = Case::parse(
+            include_str!("../../cases/verify/binary_collision.toml"),
+            "b.toml",
+        )
+        .unwrap();
+        let scene = crate::scene::build(&case, None).unwrap();
+        let mut particles = scene.particles;
+        particles.x[0] = Vec3::new(0.99, 0.0, 0.0);
+        particles.x[1] = Vec3::zeros();
+        Snapshot {
+            step: 0,
+            time: 0.0,
+            domain: Domain::new(Vec3::repeat(-5.0), Vec3::repeat(5.0), [false; 3]),
+            particles,
+            contacts: Vec::new(),
+        }
+    }
+
+    /// A contact Yade lists with the higher id first is turned into verdem's orientation: P the
+    /// lower index, the force and the spring on P (Newton's third law), fn along n from I to P
+    /// positive when repulsive.
+    #[test]
+    fn contacts_are_read_with_the_lower_index_first_and_the_force_on_it() {
+        let dir = tempfile::tempdir().unwrap();
+        // body 1 pushed towards −x by body 0: the force on 1 is (−2, 0.5, 0), spring (1e-3, 0, 0)
+        std::fs::write(
+            dir.path().join("contacts.7.txt"),
+            "# step 7\n1 0 -2.0 0.5 0.0 0.001 0.0 0.0\n",
+        )
+        .unwrap();
+        let c = Yade.read_contacts(dir.path(), 7, &pair()).unwrap();
+        assert_eq!(c.len(), 1);
+        assert_eq!((c[0].p, c[0].i), (0, 1));
+        assert_eq!(c[0].force.f, Vec3::new(2.0, -0.5, 0.0));
+        assert_eq!(c[0].force.fn_signed, 2.0);
+        assert_eq!(c[0].spring, Vec3::new(-0.001, 0.0, 0.0));
+        std::fs::write(dir.path().join("contacts.8.txt"), "0 5 1 2 3 4 5 6\n").unwrap();
+        let e = Yade.read_contacts(dir.path(), 8, &pair()).unwrap_err();
+        assert!(e.to_string().contains("out of range"), "{e}");
+    }
+
+    /// The generated script carries the case's values so that Python reads back the same bits,
+    /// and the wall speeds of a shear case.
+    #[test]
+    fn the_script_carries_the_cases_values_exactly() {
+        let case = Case::load(
+            &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("cases/shear_flow_quick.toml"),
+        )
+        .unwrap();
+        let s = Yade
+            .input_script(&case, "state.yade.txt", 100, Some(50))
+            .unwrap();
+        let value = |key: &str| {
+            s.lines()
+                .find_map(|l| l.trim().strip_prefix(&format!("{key}=")))
+                .and_then(|v| v.strip_suffix(','))
+                .unwrap_or_else(|| panic!("{key} missing"))
+                .to_string()
+        };
+        assert_eq!(value("dt").parse::<f64>().unwrap(), case.dt());
+        assert_eq!(value("kt").parse::<f64>().unwrap(), case.contact.kt);
+        assert_eq!(value("every"), "50");
+        assert_eq!(value("periodic"), "(True, True, False)");
+        let (vb, vt) = wall_speeds(&case).unwrap();
+        assert_eq!(value("wall_vx"), format!("({vb:?}, {vt:?})"));
+        assert!(s.ends_with(BODY));
+    }
+}

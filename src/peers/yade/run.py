@@ -198,7 +198,8 @@ O.engines = engines
 # with saves, one more iteration computes the forces of the last save
 iterations = P["steps"] + (1 if P["every"] > 0 else 0)
 start = time.perf_counter()
-O.run(iterations, True)
+if iterations > 0:  # O.run(0) would run for ever
+    O.run(iterations, True)
 seconds = time.perf_counter() - start
 if O.iter != iterations:
     raise RuntimeError("Yade stopped at iteration %d of %d" % (O.iter, iterations))
