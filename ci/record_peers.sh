@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Records golden/peers/: the peers named as arguments (default: every peer `verdem peers` lists;
-# LAMMPS and LIGGGHTS, Debian packages), 1 MPI rank each, all at once, run the shear case from
-# verdem's steady state golden/full_run/shear_flow.final.data, a save every 50000 steps; verdem
-# converts their dumps into MercuryCG saves and coarse-grains them, and runs the same steps in
-# each peer's convention (`verdem cross`). Then verdem itself (its default, MercuryDPM's
+# LAMMPS, LIGGGHTS and Yade, Debian packages), 1 MPI rank or thread each, all at once, run the
+# shear case from verdem's steady state golden/full_run/shear_flow.final.data, a save every 50000
+# steps; verdem converts their dumps into MercuryCG saves and coarse-grains them, and runs the
+# same steps in each peer's convention (`verdem cross`). Then verdem itself (its default, MercuryDPM's
 # convention, 2 threads) runs the same case from the same state for the same steps. Kept, with
 # provenance: each series' profiles (all saves, 10 blocks) and cg checks, the peers' input
 # scripts and cross-run tables, verdem's diagnostics, the comparison table (compare.md, every
 # peer recorded in golden/peers/) and one overlay of the codes (profiles.png). About 70 minutes
-# of the machine for 1e7 steps.
+# of the machine for 1e7 steps of LAMMPS and LIGGGHTS; Yade, at 300-900 steps/s, takes hours.
 #   ci/record_peers.sh [PEER ...]
 #   STEPS=N   steps of each run (default 10000000)
 #   STATE=F   the start state (default: the full run's final state)
@@ -52,7 +52,8 @@ for peer in "${PEERS[@]}"; do
   dir="$OUT/$bin"
   cp "$dir/$bin.profiles.csv" "$G/$peer.profiles.csv"
   cp "$dir/verdem.profiles.csv" "$G/verdem_as_$peer.profiles.csv"
-  cp "$dir/$bin/in.$bin" "$G/$peer.in"
+  # the generated input: in.BINARY (the LAMMPS family) or in.BINARY.py (Yade)
+  for f in "$dir/$bin/in.$bin" "$dir/$bin/in.$bin.py"; do [ -f "$f" ] && cp "$f" "$G/$peer.in"; done
   cp "$dir/cross.md" "$G/$peer.cross.md"
   checks "$dir/$bin/shear_flow" "$G/$peer.checks.txt"
   checks "$dir/verdem/shear_flow" "$G/verdem_as_$peer.checks.txt"
@@ -62,7 +63,7 @@ peer = "$peer"
 package = "${VERSION[$peer]}"
 command = "verdem cross $peer cases/shear_flow.toml --from $STATE --steps $STEPS --every 50000 --np 1"
 peer_command = "${COMMAND[$peer]}"
-verdem_as_peer = "verdem, 1 thread, tangential convention ${CONVENTION[$peer]}, no history update at setup (as the peer)"
+verdem_as_peer = "verdem, 1 thread, tangential convention ${CONVENTION[$peer]}, history update at setup and normal-force clipping as the peer's (verdem cross)"
 start_state_sha256 = "$START_SHA"
 steps = $STEPS
 every = 50000

@@ -24,7 +24,7 @@ enum Command {
     Run(cli::run::Args),
     /// Coarse-grain a MercuryCG series into z-profiles with error bars, checks and a plot.
     Cg(cli::cg::Args),
-    /// Time verdem against the installed LAMMPS and LIGGGHTS on the same case and state.
+    /// Time verdem against the installed LAMMPS, LIGGGHTS and Yade on the same case and state.
     Bench(cli::bench::Args),
     /// Run the verification cases and print expected, measured, tolerance and PASS/FAIL.
     Verify(cli::verify::Args),

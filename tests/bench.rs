@@ -1,5 +1,5 @@
 //! `verdem bench` end to end: verdem, the ceiling rows and the installed peers (Debian's LAMMPS
-//! and LIGGGHTS under OpenMPI's mpirun) run on the same state, and the tables list every
+//! and LIGGGHTS under OpenMPI's mpirun, and Yade) run on the same state, and the tables list every
 //! configuration with a measured rate. Rates are not judged here (no timings in tests).
 
 mod common;
@@ -41,6 +41,8 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
             ("lammps", "2"),
             ("liggghts", "1"),
             ("liggghts", "2"),
+            ("yade", "1"),
+            ("yade", "2"),
         ]
     );
     assert!(rows.iter().all(|r| r.2.is_finite() && r.2 > 0.0), "{csv}");
@@ -52,7 +54,7 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
         "{md}"
     );
     assert!(md.contains("the run on CPU 1 ran at "), "{md}");
-    for peer in ["lammps", "liggghts"] {
+    for peer in ["lammps", "liggghts", "yade"] {
         assert!(
             md.contains(&format!("verdem 2 threads / {peer} 2 ranks: ")),
             "{md}"

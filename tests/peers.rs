@@ -36,7 +36,7 @@ fn the_command_line_knows_the_peers_of_the_registry() {
         .lines()
         .map(|l| l.split('\t').next().unwrap())
         .collect();
-    assert_eq!(names, ["lammps", "liggghts"], "{text}");
+    assert_eq!(names, ["lammps", "liggghts", "yade"], "{text}");
     assert!(
         text.starts_with("lammps\tlmp\tlammps-granular\tmpirun --allow-run-as-root --oversubscribe -np 1 lmp -in in.lmp -log none\tlammps "),
         "{text}"
@@ -44,9 +44,9 @@ fn the_command_line_knows_the_peers_of_the_registry() {
     let out = common::verdem_ok(["peers", "liggghts"]);
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("liggghts\tliggghts\tliggghts\t"));
     for args in [
-        &["cross", "yade"][..],
-        &["verify", "--peers", "lammps,yade"],
-        &["peers", "liggghts,yade"],
+        &["cross", "mechsys"][..],
+        &["verify", "--peers", "lammps,mechsys"],
+        &["peers", "liggghts,mechsys"],
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
             .args(args)
@@ -56,7 +56,7 @@ fn the_command_line_knows_the_peers_of_the_registry() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{args:?}");
         assert!(
-            err.contains("unknown peer \"yade\" (known: lammps, liggghts)"),
+            err.contains("unknown peer \"mechsys\" (known: lammps, liggghts, yade)"),
             "{args:?}: {err}"
         );
     }

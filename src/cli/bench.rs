@@ -27,7 +27,7 @@ pub struct Args {
     /// Peers to run, comma-separated (`verdem peers` lists them; none: --peers '').
     #[arg(long, default_value_t = verdem::peers::names())]
     peers: String,
-    /// MPI ranks for the peers.
+    /// MPI ranks (Yade: OpenMP threads) for the peers.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     np: Vec<usize>,
     /// Alternating rounds.

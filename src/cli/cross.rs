@@ -12,7 +12,7 @@ use super::Finished;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The peer, by name (`verdem peers` lists them: lammps, liggghts).
+    /// The peer, by name (`verdem peers` lists them: lammps, liggghts, yade).
     #[arg(value_parser = verdem::peers::by_name)]
     peer: &'static dyn Peer,
     /// Case file (default: cases/shear_flow_quick.toml).
@@ -26,7 +26,7 @@ pub struct Args {
     /// A save every N steps.
     #[arg(long, default_value_t = 2000, value_parser = count::<u64>)]
     every: u64,
-    /// MPI ranks of the peer (and verdem's threads).
+    /// MPI ranks (Yade: OpenMP threads) of the peer, and verdem's threads.
     #[arg(long, default_value_t = 2, value_parser = count::<usize>)]
     np: usize,
     #[arg(long, default_value = "out/cross")]

@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use super::tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
-    YadeApprox,
+    YadeApprox, YadeViscEl,
 };
 use super::TangentialModel;
 
@@ -134,6 +134,8 @@ conventions! {
         "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding";
     Yade = "yade", YadeApprox, [twists_spring],
         "Yade's first-order rotation of the spring with the objective slip";
+    YadeViscEl = "yade-viscel", YadeViscEl, [twists_spring, drops_dashpot_while_sliding],
+        "Yade `Law2_ScGeom_ViscElPhys_Basic`: first-order rotation, cap on the spring only, no dashpot while sliding";
     Cundall = "cundall", Cundall1979, [],
         "Cundall & Strack 1979: no frame update at all";
     Objective = "objective", Objective, [objective, twists_spring],

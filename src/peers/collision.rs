@@ -1,5 +1,7 @@
 //! Binary collisions run in a peer: the same two spheres, law and time step as verdem's
-//! verification case, the restitution coefficient read from the peer's dump after the contact.
+//! verification case, the restitution coefficient read from the peer's dump after the contact
+//! and, where the peer records it, how long the normal force acted. A peer whose normal force
+//! is clipped at zero ([`Peer::clips_normal_force`]) is held to the clipped closed forms.
 
 use std::path::Path;
 
@@ -10,6 +12,16 @@ use crate::case::Case;
 use crate::verify::collision::{closed_form, head_on, impact_setup};
 use crate::verify::{row, Row};
 
+/// What a peer's head-on collision gave.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outcome {
+    /// The restitution coefficient.
+    pub e: f64,
+    /// How long its normal force was positive (time), if the peer records it
+    /// ([`Peer::collision_duration`]).
+    pub duration: Option<f64>,
+}
+
 /// The restitution coefficient `peer` gives for a head-on collision at speed `v0` (onto a fixed
 /// sphere when `wall`) under `case`'s law at its dt, run in `dir`.
 pub fn restitution(
@@ -19,6 +31,18 @@ pub fn restitution(
     wall: bool,
     dir: &Path,
 ) -> anyhow::Result<f64> {
+    Ok(collide(peer, case, v0, wall, dir)?.e)
+}
+
+/// A head-on collision at speed `v0` (onto a fixed sphere when `wall`) in `peer` under `case`'s
+/// law at its dt, run in `dir`.
+pub fn collide(
+    peer: &dyn Peer,
+    case: &Case,
+    v0: f64,
+    wall: bool,
+    dir: &Path,
+) -> anyhow::Result<Outcome> {
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
     let mut timed = case.clone();
     timed.run.dt = None;
@@ -32,27 +56,47 @@ pub fn restitution(
     let steps = (tc_fw / dt * 1.5).ceil() as u64 + 5;
     peer.run(1, dir, &peer.collision_script(&timed, &data, steps))?;
     let end = peer.read_frame(dir, steps)?;
-    Ok((end.v[1] - end.v[0]).x / v0)
+    Ok(Outcome {
+        e: (end.v[1] - end.v[0]).x / v0,
+        duration: peer.collision_duration(dir).transpose()?,
+    })
 }
 
 /// Rows of the binary collisions in `peer` against the closed forms, both partners, speeds
-/// 1e-3 … 10, at the case's dt.
+/// 1e-3 … 10, at the case's dt: the restitution, and the contact time where the peer records
+/// it (known to one step, as verdem's own rows).
 pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>> {
     let m = case.particle_mass();
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
+    let clipped = peer.clips_normal_force();
+    let dt = {
+        let mut timed = case.clone();
+        timed.run.dt = None;
+        timed.run.steps_per_collision = Some(per_tc);
+        timed.dt()
+    };
     let mut rows = Vec::new();
     for (label, wall, meff) in [("free-free", false, 0.5 * m), ("free-wall", true, m)] {
         let cf = closed_form(case, meff);
+        let (e, tc, kind) = if clipped {
+            (cf.e_clipped, cf.tc_clipped, " (force ends at Fn = 0)")
+        } else {
+            (cf.e, cf.tc, "")
+        };
         for v0 in [1e-3, 1e-1, 1.0, 10.0] {
             let sub = dir.join(format!("{label}-{v0}"));
-            let e = restitution(peer, case, v0, wall, &sub)?;
-            rows.push(row(
-                &format!("{} {label} v0={v0} dt=tc/{per_tc}", peer.binary()),
-                "restitution e",
-                cf.e,
-                e,
-                2e-3,
-            ));
+            let got = collide(peer, case, v0, wall, &sub)?;
+            let name = format!("{} {label} v0={v0} dt=tc/{per_tc}", peer.binary());
+            rows.push(row(&name, &format!("restitution e{kind}"), e, got.e, 2e-3));
+            if let Some(duration) = got.duration {
+                rows.push(row(
+                    &name,
+                    &format!("contact time{kind}"),
+                    tc,
+                    duration,
+                    1.01 * dt / tc,
+                ));
+            }
         }
     }
     Ok(rows)

@@ -123,7 +123,7 @@ impl Report {
 }
 
 /// Runs `peer` on `np` processes and verdem (one thread per process, tangential `convention`,
-/// normally [`Peer::convention`]) on `case` from `state` for `steps` steps, a save every
+/// normally [`Peer::convention`], the normal force clipped where the peer's is) on `case` from `state` for `steps` steps, a save every
 /// `every` steps, in `out` (`out/PEER/` holds its data file, input script, dumps and converted
 /// saves; `out/verdem/` verdem's saves). The peer's contacts in its saves are re-evaluated
 /// at the end of the step and carry no tangential spring ([`Peer::read_contacts`]), so the
@@ -145,6 +145,7 @@ pub fn cross(
     );
     let mut case = case.clone();
     case.contact.tangential = convention;
+    case.contact.clip_normal = peer.clips_normal_force();
     let overrides = Overrides {
         threads: Some(np),
         ..Overrides::default()

@@ -17,13 +17,14 @@ pub mod cross;
 pub mod lammps;
 pub mod lammps_family;
 pub mod liggghts;
+pub mod yade;
 
 use crate::case::{Case, Scene, Tangential};
 use crate::state::{Contact, Snapshot};
 use crate::Vec3;
 
 /// Every known peer, in the order of listings and default runs. A new peer is one line here.
-static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts];
+static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts, &yade::Yade];
 
 /// A peer code: how it is installed and started, how it reads verdem's cases and states, and
 /// how its saves are read back.
@@ -43,6 +44,12 @@ pub trait Peer: Sync {
     /// Whether its set-up force evaluation (before the first step) advances the tangential
     /// history, as verdem's does by default.
     fn setup_advances_history(&self) -> bool;
+
+    /// Whether its normal force is clipped at zero (no attractive tail at the end of a
+    /// contact), as verdem's `clip_normal`.
+    fn clips_normal_force(&self) -> bool {
+        false
+    }
 
     /// Writes the state `s` (spheres of mass density `density`) in its own format into `dir`
     /// under the stem `stem`; returns the file name an input script reads.
@@ -69,6 +76,12 @@ pub trait Peer: Sync {
     /// An input script running `steps` steps of a two-sphere `case` from `state` (a fixed
     /// sphere held still, with infinite mass), saving at the start and at step `steps`.
     fn collision_script(&self, case: &Case, state: &str, steps: u64) -> String;
+
+    /// How long the normal force of the collision run in `dir` ([`Peer::collision_script`])
+    /// was positive (time), if the peer records it.
+    fn collision_duration(&self, _dir: &Path) -> Option<anyhow::Result<f64>> {
+        None
+    }
 
     /// Runs `input` on `np` processes in `dir` (where its files are written); returns the
     /// seconds of its own time loop, without set-up and file reading.
@@ -179,10 +192,13 @@ mod tests {
 
     #[test]
     fn names_are_parsed_once_and_unknown_ones_listed() {
-        assert_eq!(names(), "lammps,liggghts");
+        assert_eq!(names(), "lammps,liggghts,yade");
         assert_eq!(by_name("liggghts").unwrap().binary(), "liggghts");
-        let e = by_name("yade").unwrap_err().to_string();
-        assert_eq!(e, "unknown peer \"yade\" (known: lammps, liggghts)");
+        let e = by_name("mechsys").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "unknown peer \"mechsys\" (known: lammps, liggghts, yade)"
+        );
         let list = parse_list("liggghts,lammps").unwrap();
         assert_eq!(
             list.iter().map(|p| p.name()).collect::<Vec<_>>(),

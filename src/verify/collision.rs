@@ -22,6 +22,8 @@ pub struct ClosedForm {
     /// kn δ + γn δ̇ reaches 0, at t₀ = (π − atan(2ηω/(ω² − η²)))/ω (for ω > η), and
     /// e = e^(−η t₀)(η/ω·sin ωt₀ − cos ωt₀).
     pub e_clipped: f64,
+    /// The duration of the clipped contact force, t₀ above.
+    pub tc_clipped: f64,
 }
 
 /// The closed form for `case`'s law and effective mass `meff` (`benchmark.md`; e.g. Schwager &
@@ -40,6 +42,7 @@ pub fn closed_form(case: &Case, meff: f64) -> ClosedForm {
         e: (-eta * tc).exp(),
         delta_max_per_speed: (-eta * tstar).exp() * (w * tstar).sin() / w,
         e_clipped: (-eta * t0).exp() * (eta / w * (w * t0).sin() - (w * t0).cos()),
+        tc_clipped: t0,
     }
 }
 

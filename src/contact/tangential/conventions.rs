@@ -26,6 +26,12 @@ pub type Liggghts = Convention<HalfOverlapSlip, ProjectAfter, LiggghtsCap, false
 /// rotation of the spring, torques with R − δ/2; verdem adds the dashpot and cap of the
 /// reference law (Yade's `FrictPhys` has no tangential dashpot).
 pub type YadeApprox = Convention<ObjectiveSlip, FirstOrderRotation, SpringThenTotal, false>;
+/// Yade's `Law2_ScGeom_ViscElPhys_Basic` (`pkg/dem/ViscoelasticPM.cpp`): slip of the material
+/// points at the contact point in the middle of the overlap (R − δ/2), the stored elastic force
+/// turned by `ScGeom::rotate` (first-order rotation) and then incremented, the elastic part alone
+/// capped at mu|fn| and the dashpot added only while it sticks, torques with R − δ/2. Its normal
+/// force is clipped at zero (`clip_normal`).
+pub type YadeViscEl = Convention<HalfOverlapSlip, FirstOrderRotation, LiggghtsCap, false>;
 /// Cundall & Strack (Géotechnique 29, 47, 1979): full-radius slip, no frame update at all,
 /// torques with full radii.
 pub type Cundall1979 = Convention<FullRadiusSlip, NoFrameUpdate, SpringThenTotal, true>;
