@@ -19,6 +19,25 @@ pub fn restitution(
     wall: bool,
     dir: &Path,
 ) -> anyhow::Result<f64> {
+    Ok(collide(peer, case, v0, wall, dir)?.e)
+}
+
+/// What a peer's head-on collision gives.
+struct Collision {
+    e: f64,
+    /// The steps the pair overlapped at the end of a step, where the peer records it.
+    contact_steps: Option<u64>,
+    dt: f64,
+}
+
+/// Runs the head-on collision of [`restitution`] in `peer`.
+fn collide(
+    peer: &dyn Peer,
+    case: &Case,
+    v0: f64,
+    wall: bool,
+    dir: &Path,
+) -> anyhow::Result<Collision> {
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
     let mut timed = case.clone();
     timed.run.dt = None;
@@ -32,11 +51,16 @@ pub fn restitution(
     let steps = (tc_fw / dt * 1.5).ceil() as u64 + 5;
     peer.run(1, dir, &peer.collision_script(&timed, &data, steps))?;
     let end = peer.read_frame(dir, steps)?;
-    Ok((end.v[1] - end.v[0]).x / v0)
+    Ok(Collision {
+        e: (end.v[1] - end.v[0]).x / v0,
+        contact_steps: peer.contact_steps(dir)?,
+        dt,
+    })
 }
 
 /// Rows of the binary collisions in `peer` against the closed forms, both partners, speeds
-/// 1e-3 … 10, at the case's dt.
+/// 1e-3 … 10, at the case's dt: the restitution (of the clipped law for a peer that clips the
+/// normal force) and, where the peer records it, the contact time.
 pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>> {
     let m = case.particle_mass();
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
@@ -45,14 +69,25 @@ pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>
         let cf = closed_form(case, meff);
         for v0 in [1e-3, 1e-1, 1.0, 10.0] {
             let sub = dir.join(format!("{label}-{v0}"));
-            let e = restitution(peer, case, v0, wall, &sub)?;
-            rows.push(row(
-                &format!("{} {label} v0={v0} dt=tc/{per_tc}", peer.binary()),
-                "restitution e",
-                cf.e,
-                e,
-                2e-3,
-            ));
+            let got = collide(peer, case, v0, wall, &sub)?;
+            let name = format!("{} {label} v0={v0} dt=tc/{per_tc}", peer.binary());
+            let (quantity, expected) = if peer.clips_normal() {
+                ("restitution e (force ends at Fn = 0)", cf.e_clipped)
+            } else {
+                ("restitution e", cf.e)
+            };
+            rows.push(row(&name, quantity, expected, got.e, 2e-3));
+            if let Some(n) = got.contact_steps {
+                // counted in whole steps: known to one step, as verdem's own row
+                let duration = n as f64 * got.dt;
+                rows.push(row(
+                    &name,
+                    "contact time",
+                    cf.tc,
+                    duration,
+                    1.01 * got.dt / cf.tc,
+                ));
+            }
         }
     }
     Ok(rows)

@@ -14,6 +14,7 @@ use anyhow::bail;
 
 pub mod collision;
 pub mod cross;
+pub mod kratos;
 pub mod lammps;
 pub mod lammps_family;
 pub mod liggghts;
@@ -23,7 +24,7 @@ use crate::state::{Contact, Snapshot};
 use crate::Vec3;
 
 /// Every known peer, in the order of listings and default runs. A new peer is one line here.
-static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts];
+static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts, &kratos::Kratos];
 
 /// A peer code: how it is installed and started, how it reads verdem's cases and states, and
 /// how its saves are read back.
@@ -43,6 +44,12 @@ pub trait Peer: Sync {
     /// Whether its set-up force evaluation (before the first step) advances the tangential
     /// history, as verdem's does by default.
     fn setup_advances_history(&self) -> bool;
+
+    /// Whether its normal force is clipped at zero (no attraction at the end of a contact), as
+    /// verdem's with `clip_normal = true`.
+    fn clips_normal(&self) -> bool {
+        false
+    }
 
     /// Writes the state `s` (spheres of mass density `density`) in its own format into `dir`
     /// under the stem `stem`; returns the file name an input script reads.
@@ -83,6 +90,18 @@ pub trait Peer: Sync {
     /// Its contacts at save `step` of a run in `dir`, as verdem contacts of the state `s` (its
     /// particles at that save): P the lower index, the force on P, sorted by `(p, i)`.
     fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>>;
+
+    /// Whether [`Peer::read_contacts`] can give its contact forces at all (a cross-run without
+    /// them compares particles only).
+    fn has_contact_forces(&self) -> bool {
+        true
+    }
+
+    /// The number of steps the pair of a collision run in `dir` ([`Peer::collision_script`])
+    /// overlapped at the end of a step, where the peer records it.
+    fn contact_steps(&self, _dir: &Path) -> anyhow::Result<Option<u64>> {
+        Ok(None)
+    }
 }
 
 impl fmt::Debug for dyn Peer + '_ {
@@ -179,10 +198,10 @@ mod tests {
 
     #[test]
     fn names_are_parsed_once_and_unknown_ones_listed() {
-        assert_eq!(names(), "lammps,liggghts");
+        assert_eq!(names(), "lammps,liggghts,kratos");
         assert_eq!(by_name("liggghts").unwrap().binary(), "liggghts");
         let e = by_name("yade").unwrap_err().to_string();
-        assert_eq!(e, "unknown peer \"yade\" (known: lammps, liggghts)");
+        assert_eq!(e, "unknown peer \"yade\" (known: lammps, liggghts, kratos)");
         let list = parse_list("liggghts,lammps").unwrap();
         assert_eq!(
             list.iter().map(|p| p.name()).collect::<Vec<_>>(),
