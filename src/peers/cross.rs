@@ -8,7 +8,9 @@
 //! the largest position difference first exceeds 1e-6 measures that onset. Both series are
 //! written as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact
 //! dumps), coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`,
-//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof).
+//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof). A peer without contact
+//! forces (Kratos DEM, [`Peer::has_contact_forces`]) is compared particle by particle only; its
+//! normal force is clipped, so verdem's is too ([`Peer::clips_normal`]).
 
 use std::fmt::Write;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //!
 //! The Python is `$VERDEM_PYTHON`, else `python3`; Kratos DEM is installed into it with
 //! [`PIP_INSTALL`]. The mapping of the benchmark's law onto Kratos' (with the Kratos sources
-//! of each parameter) is in the driver's header and in `docs/peers.md`: the normal law is the
+//! of each parameter) is in the driver's header and in `docs/verification.md` ("Kratos DEM as a peer"): the normal law is the
 //! benchmark's with the force clipped at zero; the absolute normal damping is exact for
 //! spheres of one mass; the tangential dashpot is γn·√(kt/kn) instead of γt and the Coulomb
 //! cap splits the force between spring and dashpot in Kratos' own way, so no verdem convention
@@ -188,11 +188,11 @@ impl Peer for Kratos {
     }
 
     /// No verdem convention integrates Kratos' tangential law (its dashpot is γn·√(kt/kn),
-    /// its Coulomb cap splits the force between spring and dashpot): the closest is LIGGGHTS'
-    /// (a stored spring turned into the new contact plane, capped on its own, no dashpot
-    /// while the spring alone exceeds the cap).
+    /// its Coulomb cap splits the force between spring and dashpot): MercuryDPM's, which caps
+    /// spring and dashpot together as Kratos does while the spring alone is below the cap,
+    /// follows it as closely as any (`docs/verification.md` ("Kratos DEM as a peer")).
     fn convention(&self) -> Tangential {
-        Tangential::Liggghts
+        Tangential::Mercury
     }
 
     /// Kratos has no set-up force evaluation: its first step computes the forces at the
