@@ -141,3 +141,51 @@ fn a_python_without_kratos_is_named_with_the_pip_line() {
         "{text}"
     );
 }
+
+/// What Kratos cannot express, shown with one step of two touching spheres (the force on the
+/// free one read from its velocity change: F(0) = m·(u(1) − u(0))/dt, the save at step 0
+/// holding (u(0) + u(1))/2): the free sphere slides past a fixed one at 0.01 with an overlap of
+/// 1e-3. The normal force is kn·δ; the tangential one is the dashpot's alone at the first step
+/// (no displacement yet), and its coefficient is Kratos' 2·DAMPING_GAMMA·√(m_eq·kt) =
+/// γn·√(kt/kn), not the benchmark's γt = 2/7·γn: Kratos has one damping ratio for both.
+#[test]
+fn kratos_tangential_dashpot_is_tied_to_the_normal_one() {
+    use verdem::verify::collision::{impact_setup, Body};
+    use verdem::Vec3;
+    let case = verdem::case::Case::load(&common::root().join("cases/verify/binary_collision.toml"))
+        .unwrap();
+    let (v, overlap) = (0.01, 1e-3);
+    let body = |x: f64, vy: f64, fixed: bool| Body {
+        x: Vec3::new(x, 0.0, 0.0),
+        v: Vec3::new(0.0, vy, 0.0),
+        w: Vec3::zeros(),
+        radius: None,
+        fixed,
+    };
+    let bodies = [
+        body(-0.5 + overlap / 2.0, v, false),
+        body(0.5 - overlap / 2.0, 0.0, true),
+    ];
+    let (timed, e) = impact_setup(&case, bodies, 50.0).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let state = kratos()
+        .write_state(&e.snapshot(), 1.0, dir.path(), "pair")
+        .unwrap();
+    kratos()
+        .run(1, dir.path(), &kratos().collision_script(&timed, &state, 1))
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    let save = kratos().read_frame(dir.path(), 0).unwrap();
+    let (m, dt) = (timed.particle_mass(), timed.dt());
+    let f = (save.v[0] - Vec3::new(0.0, v, 0.0)) * (2.0 * m / dt);
+    let c = &timed.contact;
+    let kratos_gt = c.gamman * (c.kt / c.kn).sqrt();
+    assert!(
+        ((-f.x - c.kn * overlap) / (c.kn * overlap)).abs() < 1e-6,
+        "normal {f:?}"
+    );
+    assert!(
+        ((-f.y / v - kratos_gt) / kratos_gt).abs() < 1e-6,
+        "tangential {f:?}"
+    );
+    assert!((kratos_gt / c.gammat - 1.87).abs() < 0.01);
+}
