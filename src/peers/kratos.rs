@@ -1,5 +1,5 @@
 //! Kratos DEM (PyPI `KratosMultiphysics` and `KratosDEMApplication` 10.4.4) run from Python:
-//! verdem writes the state as an MDPA file, the run's settings as `kratos.json` and a driver
+//! verdem writes the state as an MDPA file (and its forces beside it), the run's settings as `kratos.json` and a driver
 //! script (`kratos/driver.py`) that sets Kratos' DEM analysis up from them, runs it and writes
 //! its saves in the LAMMPS dump layout ([`crate::peers::lammps_family::dump`]).
 //!
@@ -22,6 +22,7 @@ use super::{Frame, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::atomic;
 use crate::state::{Contact, Motion, Snapshot};
+use crate::Vec3;
 
 /// Kratos DEM.
 pub struct Kratos;
@@ -118,6 +119,37 @@ pub fn mdpa(s: &Snapshot) -> String {
     out
 }
 
+/// The force and torque on each sphere from the contacts of `s` (their last evaluation), one
+/// line `id fx fy fz tx ty tz` per sphere with a contact. Numbers round-trip.
+pub fn forces(s: &Snapshot) -> String {
+    let n = s.particles.len();
+    let mut f = vec![(Vec3::zeros(), Vec3::zeros()); n];
+    for c in &s.contacts {
+        let (p, i) = (c.p as usize, c.i as usize);
+        f[p].0 += c.force.f;
+        f[p].1 += c.force.torque_p;
+        f[i].0 -= c.force.f;
+        f[i].1 += c.force.torque_i;
+    }
+    let mut out = String::new();
+    for (a, (force, torque)) in f.iter().enumerate() {
+        if *force != Vec3::zeros() || *torque != Vec3::zeros() {
+            let _ = writeln!(
+                out,
+                "{} {:?} {:?} {:?} {:?} {:?} {:?}",
+                a + 1,
+                force.x,
+                force.y,
+                force.z,
+                torque.x,
+                torque.y,
+                torque.z
+            );
+        }
+    }
+    out
+}
+
 /// The settings of a run of `case` from `state` for `steps` steps, a save every `every` steps
 /// (0: none), as the JSON object the driver reads; `count_contact` makes it count the steps
 /// at whose end the first two spheres overlap. Numbers round-trip.
@@ -205,8 +237,10 @@ impl Peer for Kratos {
         true
     }
 
-    /// The MDPA file ([`mdpa`]) `stem.mdpa`; the driver copies it to the name Kratos reads.
-    /// The density enters through the settings ([`Peer::input_script`]).
+    /// The MDPA file ([`mdpa`]) `stem.mdpa`, which the driver copies to the name Kratos reads,
+    /// and beside it the state's forces ([`forces`]) `stem.forces.txt`, from which the driver
+    /// turns the state's velocities into the half-step ones Kratos' scheme starts from. The
+    /// density enters through the settings ([`Peer::input_script`]).
     fn write_state(
         &self,
         s: &Snapshot,
@@ -216,6 +250,10 @@ impl Peer for Kratos {
     ) -> anyhow::Result<String> {
         let name = format!("{stem}.mdpa");
         atomic::write(&dir.join(&name), mdpa(s).as_bytes())?;
+        atomic::write(
+            &dir.join(format!("{stem}.forces.txt")),
+            forces(s).as_bytes(),
+        )?;
         Ok(name)
     }
 

@@ -209,6 +209,27 @@ def save(stage, pending):
     os.replace("dump.%d.txt.tmp" % step, "dump.%d.txt" % step)
 
 
+def half_kick_back(mp, m, radius):
+    """Kratos' scheme starts from the half-step velocity u(0) = v(0) - F(0) dt/(2m) (and
+    w(0) - T(0) dt/(2I), I = 2/5 m r^2): the state's forces, written by verdem beside the state
+    as STATE.forces.txt, turn its velocities into those, for the free spheres."""
+    path = S["state"][: -len(".mdpa")] + ".forces.txt"
+    if not os.path.exists(path):
+        return
+    inertia = 0.4 * m * radius ** 2
+    free = {n.Id for n in mp.GetSubModelPart("free").Nodes} if mp.HasSubModelPart("free") else set()
+    for line in open(path):
+        f = line.split()
+        node = int(f[0])
+        if node not in free:
+            continue
+        n = mp.GetNode(node)
+        for k, var in enumerate((K.VELOCITY_X, K.VELOCITY_Y, K.VELOCITY_Z)):
+            n.SetSolutionStepValue(var, n.GetSolutionStepValue(var) - float(f[1 + k]) * S["dt"] / (2.0 * m))
+        for k, var in enumerate((K.ANGULAR_VELOCITY_X, K.ANGULAR_VELOCITY_Y, K.ANGULAR_VELOCITY_Z)):
+            n.SetSolutionStepValue(var, n.GetSolutionStepValue(var) - float(f[4 + k]) * S["dt"] / (2.0 * inertia))
+
+
 def main():
     if not os.path.exists(MDPA) or not os.path.samefile(S["state"], MDPA):
         with open(S["state"]) as src, open(MDPA, "w") as dst:
@@ -242,6 +263,7 @@ def main():
     for p in mp.Properties:
         for sub in p.GetSubProperties():
             sub.SetValue(DEM.DAMPING_GAMMA, gamma)
+    half_kick_back(mp, m, radius)
     stage.verdem_pending = record(stage) if S["every"] else None
     start = time.perf_counter()
     stage.RunSolutionLoop()
