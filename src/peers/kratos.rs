@@ -1,7 +1,8 @@
 //! Kratos DEM (PyPI `KratosMultiphysics` and `KratosDEMApplication` 10.4.4) run from Python:
-//! verdem writes the state as an MDPA file (and its forces beside it), the run's settings as `kratos.json` and a driver
-//! script (`kratos/driver.py`) that sets Kratos' DEM analysis up from them, runs it and writes
-//! its saves in the LAMMPS dump layout ([`crate::peers::lammps_family::dump`]).
+//! verdem writes the state as an MDPA file (its forces beside it), the run's settings as
+//! `kratos.json` and a driver script (`kratos/driver.py`) that sets Kratos' DEM analysis up from
+//! them, runs it and writes its saves in the LAMMPS dump layout
+//! ([`crate::peers::lammps_family::dump`]).
 //!
 //! The Python is `$VERDEM_PYTHON`, else `python3`; Kratos DEM is installed into it with
 //! [`PIP_INSTALL`]. The mapping of the benchmark's law onto Kratos' (with the Kratos sources
