@@ -9,7 +9,16 @@ fn bench_runs_verdem_and_both_peers_on_one_state_and_writes_both_tables() {
     let dir = tempfile::tempdir().unwrap();
     let state = common::data("states/mercury_t143.85.data");
     let args = [
-        "bench", "--steps", "300", "--rounds", "1", "--np", "1,2", "--out",
+        "bench",
+        "--steps",
+        "300",
+        "--rounds",
+        "1",
+        "--np",
+        "1,2",
+        "--peers",
+        "lammps,liggghts,yade",
+        "--out",
     ];
     let mut args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
     args.extend([dir.path().as_os_str(), "--from".as_ref(), state.as_os_str()]);

@@ -12,7 +12,7 @@ use super::Finished;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The peer, by name (`verdem peers` lists them: lammps, liggghts, yade).
+    /// The peer, by name (`verdem peers` lists them: lammps, liggghts, yade, kratos).
     #[arg(value_parser = verdem::peers::by_name)]
     peer: &'static dyn Peer,
     /// Case file (default: cases/shear_flow_quick.toml).

@@ -17,7 +17,8 @@ pub struct Args {
     /// Only the rows whose case name contains this text.
     #[arg(long)]
     only: Option<String>,
-    /// Also run the binary collisions in these installed peers (lammps, liggghts, yade), against
+    /// Also run the binary collisions in these installed peers (lammps, liggghts, yade,
+    /// kratos), against
     /// the same closed forms.
     #[arg(long, value_parser = peers::by_name, value_delimiter = ',')]
     peers: Vec<&'static dyn Peer>,

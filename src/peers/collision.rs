@@ -20,6 +20,9 @@ pub struct Outcome {
     /// How long its normal force was positive (time), if the peer records it
     /// ([`Peer::collision_duration`]).
     pub duration: Option<f64>,
+    /// How long the spheres overlapped at the end of a step (time, whole steps), if the peer
+    /// records it ([`Peer::contact_steps`]).
+    pub overlapped: Option<f64>,
 }
 
 /// The restitution coefficient `peer` gives for a head-on collision at speed `v0` (onto a fixed
@@ -59,6 +62,7 @@ pub fn collide(
     Ok(Outcome {
         e: (end.v[1] - end.v[0]).x / v0,
         duration: peer.collision_duration(dir).transpose()?,
+        overlapped: peer.contact_steps(dir)?.map(|n| n as f64 * dt),
     })
 }
 
@@ -95,6 +99,16 @@ pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>
                     tc,
                     duration,
                     1.01 * dt / tc,
+                ));
+            }
+            if let Some(overlapped) = got.overlapped {
+                // counted in whole steps: known to one step, as verdem's own row
+                rows.push(row(
+                    &name,
+                    "overlap time",
+                    cf.tc,
+                    overlapped,
+                    1.01 * dt / cf.tc,
                 ));
             }
         }

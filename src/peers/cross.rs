@@ -8,7 +8,9 @@
 //! the largest position difference first exceeds 1e-6 measures that onset. Both series are
 //! written as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact
 //! dumps), coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`,
-//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof).
+//! overlaid in `profiles.png`, and compared profile by profile (χ²/dof). A peer without contact
+//! forces (Kratos DEM, [`Peer::has_contact_forces`]) is compared particle by particle only; its
+//! normal force is clipped, so verdem's is too ([`Peer::clips_normal_force`]).
 
 use std::fmt::Write;
 use std::path::Path;
@@ -61,8 +63,9 @@ pub struct Report {
     pub convention: Tangential,
     pub saves: Vec<SaveDiff>,
     /// χ²/dof of each profile of [`cg::FIELDS`] of the peer's series against verdem's (all
-    /// saves coarse-grained, block standard errors).
-    pub profiles_chi2: [f64; 5],
+    /// saves coarse-grained, block standard errors); none when the peer gives no contact
+    /// forces ([`Peer::has_contact_forces`]), without which its stresses are unknown.
+    pub profiles_chi2: Option<[f64; 5]>,
 }
 
 impl Report {
@@ -78,9 +81,12 @@ impl Report {
     /// (≈ 1 when the two differ by noise only; the quantity is the profile's name, the case
     /// the peer's).
     pub fn profile_verdicts(&self) -> Vec<Verdict> {
+        let Some(chi2) = self.profiles_chi2 else {
+            return Vec::new();
+        };
         cg::FIELDS
             .iter()
-            .zip(self.profiles_chi2)
+            .zip(chi2)
             .map(|((name, _), c)| Verdict::reported(self.peer.binary(), name, c, Limit::None))
             .collect()
     }
@@ -113,11 +119,19 @@ impl Report {
             .iter()
             .map(|v| format!("{} {:.2}", v.quantity, v.measured))
             .collect();
-        let _ = writeln!(
-            s,
-            "profiles over all saves, chi2/dof against verdem (1 = noise): {}",
-            chi2.join(", ")
-        );
+        let _ = if self.profiles_chi2.is_some() {
+            writeln!(
+                s,
+                "profiles over all saves, chi2/dof against verdem (1 = noise): {}",
+                chi2.join(", ")
+            )
+        } else {
+            writeln!(
+                s,
+                "profiles not compared: {} gives no per-contact forces, so its stresses are unknown",
+                self.peer.binary()
+            )
+        };
         s
     }
 }
@@ -184,9 +198,11 @@ pub fn cross(
         theirs.particles.v = frame.v;
         theirs.particles.w = frame.w;
         theirs.particles.radius = frame.radius;
-        theirs.contacts = peer.read_contacts(&peer_dir, k * every, &theirs)?;
         atomic::write(&peer_dir.join(&name), data_text(&theirs).as_bytes())?;
-        atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
+        if peer.has_contact_forces() {
+            theirs.contacts = peer.read_contacts(&peer_dir, k * every, &theirs)?;
+            atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
+        }
         let (a, b) = (&own.particles, &theirs.particles);
         let n = a.len();
         let diff = |f: &dyn Fn(usize) -> f64| Spread::of(&(0..n).map(f).collect::<Vec<_>>());
@@ -201,26 +217,30 @@ pub fn cross(
     o.from = Some(0);
     o.blocks = saves.len().div_ceil(4).clamp(2, 10);
     let series = |dir: &Path| cg::Series::find(&dir.join(&case.name));
-    let (own, theirs) = (
-        cg::coarse_grain(&series(&own_dir)?, &o)?,
-        cg::coarse_grain(&series(&peer_dir)?, &o)?,
-    );
-    let (own_table, their_table) = (Table::of(&own), Table::of(&theirs));
-    atomic::write(
-        &out.join(format!("{}.profiles.csv", peer.binary())),
-        their_table.csv().as_bytes(),
-    )?;
+    let own = cg::coarse_grain(&series(&own_dir)?, &o)?;
+    let own_table = Table::of(&own);
     atomic::write(&out.join("verdem.profiles.csv"), own_table.csv().as_bytes())?;
-    cg::plot::overlay_png(
-        &[(peer.binary(), &their_table), ("verdem", &own_table)],
-        &out.join("profiles.png"),
-    )?;
+    let profiles_chi2 = if peer.has_contact_forces() {
+        let theirs = cg::coarse_grain(&series(&peer_dir)?, &o)?;
+        let their_table = Table::of(&theirs);
+        atomic::write(
+            &out.join(format!("{}.profiles.csv", peer.binary())),
+            their_table.csv().as_bytes(),
+        )?;
+        cg::plot::overlay_png(
+            &[(peer.binary(), &their_table), ("verdem", &own_table)],
+            &out.join("profiles.png"),
+        )?;
+        Some(cg::FIELDS.map(|(_, col)| cg::chi2(&theirs, &own, col)))
+    } else {
+        None
+    };
     let report = Report {
         peer,
         np,
         convention: case.contact.tangential,
         saves,
-        profiles_chi2: cg::FIELDS.map(|(_, col)| cg::chi2(&theirs, &own, col)),
+        profiles_chi2,
     };
     atomic::write(&out.join("cross.md"), report.markdown().as_bytes())?;
     Ok(report)

@@ -14,6 +14,7 @@ use anyhow::bail;
 
 pub mod collision;
 pub mod cross;
+pub mod kratos;
 pub mod lammps;
 pub mod lammps_family;
 pub mod liggghts;
@@ -24,7 +25,12 @@ use crate::state::{Contact, Snapshot};
 use crate::Vec3;
 
 /// Every known peer, in the order of listings and default runs. A new peer is one line here.
-static ALL: &[&dyn Peer] = &[&lammps::Lammps, &liggghts::Liggghts, &yade::Yade];
+static ALL: &[&dyn Peer] = &[
+    &lammps::Lammps,
+    &liggghts::Liggghts,
+    &yade::Yade,
+    &kratos::Kratos,
+];
 
 /// A peer code: how it is installed and started, how it reads verdem's cases and states, and
 /// how its saves are read back.
@@ -96,6 +102,24 @@ pub trait Peer: Sync {
     /// Its contacts at save `step` of a run in `dir`, as verdem contacts of the state `s` (its
     /// particles at that save): P the lower index, the force on P, sorted by `(p, i)`.
     fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>>;
+
+    /// Whether [`Peer::read_contacts`] can give its contact forces at all (a cross-run without
+    /// them compares particles only).
+    fn has_contact_forces(&self) -> bool {
+        true
+    }
+
+    /// The number of steps the pair of a collision run in `dir` ([`Peer::collision_script`])
+    /// overlapped at the end of a step, where the peer records it.
+    fn contact_steps(&self, _dir: &Path) -> anyhow::Result<Option<u64>> {
+        Ok(None)
+    }
+
+    /// Whether `verdem bench` times it when no `--peers` are given: false for a peer so slow
+    /// that the default rounds would take hours (it is timed when named).
+    fn timed_by_default(&self) -> bool {
+        true
+    }
 }
 
 impl fmt::Debug for dyn Peer + '_ {
@@ -130,6 +154,16 @@ pub fn all() -> &'static [&'static dyn Peer] {
 /// The names of all known peers, comma-separated (`lammps,liggghts`).
 pub fn names() -> String {
     known(",")
+}
+
+/// The names of the peers `verdem bench` times by default ([`Peer::timed_by_default`]), joined
+/// by commas.
+pub fn bench_names() -> String {
+    ALL.iter()
+        .filter(|p| p.timed_by_default())
+        .map(|p| p.name())
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// The names of all known peers, joined by `sep`.
@@ -192,12 +226,12 @@ mod tests {
 
     #[test]
     fn names_are_parsed_once_and_unknown_ones_listed() {
-        assert_eq!(names(), "lammps,liggghts,yade");
+        assert_eq!(names(), "lammps,liggghts,yade,kratos");
         assert_eq!(by_name("liggghts").unwrap().binary(), "liggghts");
         let e = by_name("mechsys").unwrap_err().to_string();
         assert_eq!(
             e,
-            "unknown peer \"mechsys\" (known: lammps, liggghts, yade)"
+            "unknown peer \"mechsys\" (known: lammps, liggghts, yade, kratos)"
         );
         let list = parse_list("liggghts,lammps").unwrap();
         assert_eq!(
