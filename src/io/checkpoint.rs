@@ -177,14 +177,17 @@ pub fn restore(
     let mut differs = tag_differences(&file_tag, tag);
     let particles = engine.state().particles.len();
     if n != particles as u64 {
-        differs.push(format!("{n} particles, the case {particles}"));
+        differs.push(format!("{n} particles, the case's {particles}"));
     }
     let case_dt = engine.params().dt;
     if dt.to_bits() != case_dt.to_bits() {
-        differs.push(format!("dt {dt}, the case {case_dt}"));
+        differs.push(format!("dt {dt}, the case's {case_dt} (run.dt)"));
     }
     if !differs.is_empty() {
-        bail!("{file}: checkpoint of another run: {}", differs.join("; "));
+        bail!(
+            "{file}: refused, a checkpoint of another run: {}",
+            differs.join("; ")
+        );
     }
     let mut snap = engine.snapshot();
     snap.step = step;
@@ -202,7 +205,7 @@ pub fn restore(
     let case_words = engine.history_words();
     if contacts > 0 && words != case_words as u64 {
         bail!(
-            "{file}: checkpoint of another run: {words} history words per contact, the case's \
+            "{file}: refused, a checkpoint of another run: {words} history words per contact, the case's \
              law {case_words} (another contact law)"
         );
     }
@@ -269,7 +272,7 @@ fn tag_differences(file_tag: &str, tag: &str) -> Vec<String> {
         match theirs.iter().find(|(kk, _)| kk == k) {
             Some((_, w)) if w == v => {}
             Some((_, w)) if k == "case" => out.push(format!("checkpoint of case {w}, not {v}")),
-            Some((_, w)) => out.push(format!("{k} {w}, the case's {v}")),
+            Some((_, w)) => out.push(format!("{} {w}, the case's {v}", field_name(k))),
             None => out.push(format!("no {k} (the case's {v})")),
         }
     }
@@ -279,4 +282,12 @@ fn tag_differences(file_tag: &str, tag: &str) -> Vec<String> {
         }
     }
     out
+}
+
+/// How a tag field is named in messages: what it is and where a case sets it.
+fn field_name(key: &str) -> String {
+    match key {
+        "tangential" => "tangential convention (contact.tangential)".into(),
+        k => k.into(),
+    }
 }
