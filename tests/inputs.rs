@@ -255,6 +255,14 @@ fn an_absurd_count_is_refused_before_anything_is_reserved_for_it() {
         ],
     );
     init_refused(
+        "count_2_64.data",
+        &std::fs::read(corpus("malformed/count_2_64.data")).unwrap(),
+        &[
+            "count_2_64.data:1:",
+            "N (particles): expected a whole number >= 0, got 1.8446744073709552e19",
+        ],
+    );
+    init_refused(
         "hugecount.official.data",
         &std::fs::read(corpus("malformed/hugecount.official.data")).unwrap(),
         &[
@@ -748,8 +756,14 @@ enum Mutation {
     DeleteLine(prop::sample::Index),
     /// Repeat a line.
     DuplicateLine(prop::sample::Index),
-    /// Replace a word or CSV field by a troublesome token.
-    Token(prop::sample::Index, prop::sample::Index, &'static str),
+    /// Replace a word or CSV field by a troublesome token, on any line or (`head`) on one of
+    /// the first ten, where the headers and their counts are.
+    Token {
+        line: prop::sample::Index,
+        head: bool,
+        word: prop::sample::Index,
+        token: &'static str,
+    },
     /// Insert bytes that are not UTF-8.
     NotUtf8(prop::sample::Index, &'static [u8]),
     /// Overwrite 8 bytes with a troublesome little-endian word (a count, NaN, an infinity).
@@ -782,17 +796,23 @@ const TOKENS: [&str; 20] = [
 fn mutation() -> impl Strategy<Value = Mutation> {
     use prop::sample::Index;
     prop_oneof![
-        (any::<Index>(), 0u8..8).prop_map(|(i, b)| Mutation::Flip(i, b)),
-        any::<Index>().prop_map(Mutation::Truncate),
-        any::<Index>().prop_map(Mutation::DeleteLine),
-        any::<Index>().prop_map(Mutation::DuplicateLine),
-        (
+        1 => (any::<Index>(), 0u8..8).prop_map(|(i, b)| Mutation::Flip(i, b)),
+        1 => any::<Index>().prop_map(Mutation::Truncate),
+        1 => any::<Index>().prop_map(Mutation::DeleteLine),
+        1 => any::<Index>().prop_map(Mutation::DuplicateLine),
+        3 => (
             any::<Index>(),
+            any::<bool>(),
             any::<Index>(),
             prop::sample::select(TOKENS.to_vec())
         )
-            .prop_map(|(l, w, t)| Mutation::Token(l, w, t)),
-        (
+            .prop_map(|(line, head, word, token)| Mutation::Token {
+                line,
+                head,
+                word,
+                token
+            }),
+        1 => (
             any::<Index>(),
             prop::sample::select(vec![
                 &b"\xff"[..],
@@ -803,7 +823,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
             ])
         )
             .prop_map(|(i, b)| Mutation::NotUtf8(i, b)),
-        (
+        1 => (
             any::<Index>(),
             prop::sample::select(vec![
                 u64::MAX,
@@ -846,14 +866,19 @@ fn apply(bytes: &[u8], m: &Mutation) -> Vec<u8> {
             l.insert(k, l[k].clone());
             out = l.join(&b'\n');
         }
-        Mutation::Token(li, wi, tok) => {
+        Mutation::Token {
+            line,
+            head,
+            word,
+            token,
+        } => {
             let mut l = lines(&out);
-            let k = li.index(l.len());
+            let k = line.index(if *head { l.len().min(10) } else { l.len() });
             let text = String::from_utf8_lossy(&l[k]).to_string();
             let sep = if text.contains(',') { "," } else { " " };
             let mut words: Vec<&str> = text.split(sep).collect();
-            let w = wi.index(words.len());
-            words[w] = tok;
+            let w = word.index(words.len());
+            words[w] = token;
             l[k] = words.join(sep).into_bytes();
             out = l.join(&b'\n');
         }
@@ -880,7 +905,7 @@ fn mutated(seed: &'static str) -> impl Strategy<Value = Vec<u8>> {
 /// Cases per reader: the whole fuzz set runs in a few seconds in release.
 fn fuzz_config() -> ProptestConfig {
     ProptestConfig {
-        cases: 1500,
+        cases: 4000,
         ..ProptestConfig::default()
     }
 }
@@ -942,7 +967,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..fuzz_config() })]
+    #![proptest_config(ProptestConfig { cases: 1000, ..fuzz_config() })]
 
     /// Loading into a scene adds the checks that need the case (box, overlaps, counts).
     #[test]
