@@ -532,6 +532,50 @@ fn a_checkpoint_of_another_case_law_step_count_or_version_is_refused_saying_what
     );
 }
 
+#[test]
+fn a_checkpoint_with_other_history_words_or_a_non_finite_number_is_refused_naming_it() {
+    let bytes = corpus_bytes("small.checkpoint");
+    let tag = checkpoint::tag(&small_case());
+    // magic, version, tag length, tag, step, time, dt, particle count, then the words
+    let words_at = 8 + 8 + 8 + tag.len() + 8 + 8 + 8 + 8;
+    let words = u64::from_le_bytes(bytes[words_at..words_at + 8].try_into().unwrap());
+    let mut e = small_engine();
+    assert_eq!(words, e.history_words() as u64);
+    let mut other = bytes.clone();
+    other[words_at..words_at + 8].copy_from_slice(&(words + 1).to_le_bytes());
+    let err = checkpoint::restore("c.ck", &other, e.as_mut(), &tag)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(&format!(
+            "c.ck: refused, a checkpoint of another run: {} history words per contact, the case's law {words}",
+            words + 1
+        )),
+        "{err}"
+    );
+    // the first particle's x follows the words
+    let x_at = words_at + 8;
+    let mut nan = bytes.clone();
+    nan[x_at..x_at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    let err = checkpoint::restore("c.ck", &nan, e.as_mut(), &tag)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!("c.ck: byte {x_at}: particle 1: position[0] is not finite (NaN)")
+    );
+    let mut longer = bytes.clone();
+    longer.push(0);
+    let err = checkpoint::restore("c.ck", &longer, e.as_mut(), &tag)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(err, "c.ck: 1 trailing bytes after the checkpoint");
+    assert_eq!(
+        checkpoint::restore("c.ck", &bytes, e.as_mut(), &tag).unwrap(),
+        10
+    );
+}
+
 /// `verdem cg DIR/s` over the seed save with its `.fstat` replaced, refused with `expect`.
 fn cg_refused(fstat: &[u8], expect: &[&str]) {
     let dir = tempfile::tempdir().unwrap();

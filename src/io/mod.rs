@@ -74,11 +74,12 @@ pub fn utf8(file: &str, bytes: Vec<u8>) -> Result<String, FormatError> {
     })
 }
 
-fn not_utf8(column: usize, byte: u8) -> String {
+/// The message for byte `byte`, at offset `at` (from 0) of its line, that is not UTF-8.
+fn not_utf8(at: usize, byte: u8) -> String {
     format!(
-        "not UTF-8 text: byte 0x{byte:02x} at character {} of the line (a binary or \
-         differently encoded file?)",
-        column + 1
+        "not UTF-8 text: byte 0x{byte:02x} at byte {} of the line (a binary or differently \
+         encoded file?)",
+        at + 1
     )
 }
 
@@ -133,7 +134,8 @@ impl<R: BufRead> Lines<R> {
         }
     }
 
-    /// The first bytes of the stream, not consumed (to tell formats apart).
+    /// The next bytes of the stream, not consumed: before the first line, its first bytes (to
+    /// tell formats apart).
     pub fn peek(&mut self) -> Result<&[u8], FormatError> {
         let file = &self.file;
         self.reader.fill_buf().map_err(|e| FormatError {
