@@ -253,6 +253,14 @@ fn bad_row(record: &csv::StringRecord, e: csv::Error) -> String {
 /// missing or extra columns, non-numbers, times that do not increase and quaternions whose
 /// norm is not 1 within 1e-6, naming the file, line and column.
 pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatError> {
+    Ok(parse_motion_lines(file, text)?
+        .into_iter()
+        .map(|(_, row)| row)
+        .collect())
+}
+
+/// As [`parse_motion`], with the line of each row.
+pub fn parse_motion_lines(file: &str, text: &str) -> Result<Vec<(usize, MotionRow)>, FormatError> {
     let mut records = crate::io::csv_table::records(file, text, true);
     let (hline, header) = records
         .find(|r| r.as_ref().map_or(true, |(_, h)| !blank_or_comment(h)))
@@ -265,11 +273,14 @@ pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatErro
             format!(
                 "header must be `{}`, got `{}`",
                 MOTION_COLUMNS.join(","),
-                text.lines().nth(hline - 1).unwrap_or_default().trim()
+                text.lines()
+                    .nth(hline.saturating_sub(1))
+                    .unwrap_or_default()
+                    .trim()
             ),
         ));
     }
-    let mut rows: Vec<MotionRow> = Vec::new();
+    let mut rows: Vec<(usize, MotionRow)> = Vec::new();
     for record in records {
         let (line, record) = record?;
         if blank_or_comment(&record) {
@@ -318,7 +329,7 @@ pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatErro
         };
         let (x1, q1, v1, w1) = sphere(1)?;
         let (x2, q2, v2, w2) = sphere(14)?;
-        if let Some(prev) = rows.last() {
+        if let Some((_, prev)) = rows.last() {
             if v[0] <= prev.t {
                 return Err(err(
                     file,
@@ -327,13 +338,16 @@ pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatErro
                 ));
             }
         }
-        rows.push(MotionRow {
-            t: v[0],
-            x: [x1, x2],
-            q: [q1, q2],
-            v: [v1, v2],
-            w: [w1, w2],
-        });
+        rows.push((
+            line,
+            MotionRow {
+                t: v[0],
+                x: [x1, x2],
+                q: [q1, q2],
+                v: [v1, v2],
+                w: [w1, w2],
+            },
+        ));
     }
     Ok(rows)
 }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 
@@ -80,7 +80,7 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                                     bail!(
                                         "{}:{}: wall sphere {} moves at {:?}, the case prescribes {:?}",
                                         path.display(),
-                                        a + 2,
+                                        loaded.line[a],
                                         a + 1,
                                         fv.as_slice(),
                                         v.as_slice()
@@ -106,6 +106,7 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                         ),
                     }
                 }
+                check_loaded(&path, &loaded.line, &particles, &domain, case.guard.overlap)?;
             } else {
                 for (g, (pos, vx)) in walls.iter().enumerate() {
                     for x in pos {
@@ -171,15 +172,17 @@ struct Loaded {
     radius: Vec<f64>,
     v: Vec<Vec3>,
     w: Vec<Vec3>,
+    /// The line of each particle in the file.
+    line: Vec<usize>,
 }
 
-/// Reads an official initial file or a MercuryCG `.data` file, checking its box.
+/// Reads an official initial file or a MercuryCG `.data` file (told apart by their first
+/// word, read line by line), checking its box against the case's.
 fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut lines = crate::io::open(path)?;
     let file = path.display().to_string();
-    if official::looks_official(&text) {
-        let f = official::read(path, &text)?;
+    if official::looks_official(lines.peek()?) {
+        let f = official::parse(&mut lines)?;
         mercury::check_box(&file, &f.lo, &f.hi, domain, 1e-6)?;
         Ok(Loaded {
             time: 0.0,
@@ -187,9 +190,10 @@ fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
             radius: f.radius,
             v: Vec::new(),
             w: Vec::new(),
+            line: f.line,
         })
     } else {
-        let f = mercury::read_data(path)?;
+        let f = mercury::parse_data(&mut lines)?;
         mercury::check_box(&file, &f.domain_lo, &f.domain_hi, domain, 1e-6)?;
         Ok(Loaded {
             time: f.time,
@@ -197,8 +201,109 @@ fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
             radius: f.rows.iter().map(|r| r.radius).collect(),
             v: f.rows.iter().map(|r| r.v).collect(),
             w: f.rows.iter().map(|r| r.w).collect(),
+            line: f.rows.iter().map(|r| r.line).collect(),
         })
     }
+}
+
+/// Refuses a loaded state that the run guard would stop at its first step, naming the file,
+/// the lines and the particle ids (from 1, in file order): a centre outside the box (along
+/// every axis: a file's positions lie in its box, periodic or not), and a free particle
+/// overlapping another particle by more than `overlap` times the smaller radius of the two
+/// (two particles at the same place, e.g. a repeated line, included).
+fn check_loaded(
+    path: &Path,
+    line: &[usize],
+    p: &Particles,
+    domain: &Domain,
+    overlap: f64,
+) -> anyhow::Result<()> {
+    let file = path.display();
+    for a in 0..p.len() {
+        if let Some(k) = (0..3).find(|&k| !(p.x[a][k] >= domain.lo[k] && p.x[a][k] <= domain.hi[k]))
+        {
+            bail!(
+                "{file}:{}: particle {}: {} = {} is outside the case's box [{}, {}]",
+                line[a],
+                a + 1,
+                ["x", "y", "z"][k],
+                p.x[a][k],
+                domain.lo[k],
+                domain.hi[k]
+            );
+        }
+    }
+    let free = |a: usize| matches!(p.motion[a], Motion::Free);
+    for (a, b) in close_pairs(p, domain) {
+        if !free(a) && !free(b) {
+            continue;
+        }
+        let gap = domain.min_image(p.x[b] - p.x[a]).norm();
+        let delta = p.radius[a] + p.radius[b] - gap;
+        let limit = overlap * p.radius[a].min(p.radius[b]);
+        if delta > limit {
+            let kind = |a: usize| if free(a) { "free" } else { "wall" };
+            let what = if gap == 0.0 {
+                "are at the same place (a repeated line?)".to_string()
+            } else {
+                format!("overlap by {delta:e}")
+            };
+            bail!(
+                "{file}:{}: particles {} ({}, line {}) and {} ({}, line {}) {what}, beyond the \
+                 limit {limit:e} ([guard] overlap = {overlap} times the smaller radius); the run \
+                 guard would stop the first step",
+                line[a.max(b)],
+                a + 1,
+                kind(a),
+                line[a],
+                b + 1,
+                kind(b),
+                line[b],
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The pairs (a < b) of particles whose centres are closer than the sum of the two largest
+/// radii, found through a grid of cells at least that wide (positions in the box).
+fn close_pairs(p: &Particles, domain: &Domain) -> Vec<(usize, usize)> {
+    let r_max = p.radius.iter().cloned().fold(0.0, f64::max);
+    let l = domain.lengths();
+    let n = [0, 1, 2].map(|k| ((l[k] / (2.0 * r_max)).floor() as usize).clamp(1, 1 << 10));
+    let cell_of = |x: &Vec3| {
+        [0, 1, 2].map(|k| (((x[k] - domain.lo[k]) / l[k] * n[k] as f64) as usize).min(n[k] - 1))
+    };
+    let mut cells: std::collections::HashMap<[usize; 3], Vec<usize>> = Default::default();
+    for a in 0..p.len() {
+        cells.entry(cell_of(&p.x[a])).or_default().push(a);
+    }
+    let mut out = Vec::new();
+    for a in 0..p.len() {
+        let c = cell_of(&p.x[a]);
+        let mut near: Vec<[usize; 3]> = Vec::with_capacity(27);
+        for d in 0..27 {
+            let o = [d % 3, d / 3 % 3, d / 9].map(|v| v as i64 - 1);
+            let cc = [0, 1, 2].map(|k| {
+                let v = c[k] as i64 + o[k];
+                (domain.periodic[k] || (0..n[k] as i64).contains(&v))
+                    .then(|| v.rem_euclid(n[k] as i64) as usize)
+            });
+            if let [Some(x), Some(y), Some(z)] = cc {
+                if !near.contains(&[x, y, z]) {
+                    near.push([x, y, z]);
+                }
+            }
+        }
+        for cc in near {
+            for &b in cells.get(&cc).into_iter().flatten() {
+                if b > a && domain.min_image(p.x[b] - p.x[a]).norm() < 2.0 * r_max {
+                    out.push((a, b));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Centres of one hexagonal bumpy wall at height `z`, in the order of the official file:

@@ -32,10 +32,28 @@ pub struct Args {
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let case = Case::load(&a.case)?;
     let (file, text) = io::read_text(&a.motion)?;
-    let rows = kinematics::parse_motion(&file, &text)?;
+    let (lines, rows): (Vec<usize>, Vec<_>) = kinematics::parse_motion_lines(&file, &text)?
+        .into_iter()
+        .unzip();
     let (_, radius) = kinematics::pair_of(&case)?;
     let law = kinematics::law_of(&case);
     let forces = kinematics::drive(law.as_ref(), radius, &rows, a.increment);
+    let finite = |r: &kinematics::ForceRow| {
+        let vectors = r.f.iter().chain(&r.torque).flat_map(|v| v.iter().copied());
+        [r.t, r.delta, r.fn_signed, r.ft]
+            .into_iter()
+            .chain(vectors)
+            .all(f64::is_finite)
+    };
+    if let Some(k) = forces.iter().position(|r| !finite(r)) {
+        anyhow::bail!(
+            "{file}:{}: the law's forces or overlap at t = {} are not finite (numbers too large \
+             for the law, or rows too close in time); {} not written",
+            lines[k],
+            rows[k].t,
+            a.out.display()
+        );
+    }
     atomic::write(&a.out, kinematics::forces_csv(&forces).as_bytes())?;
     println!(
         "{} rows of {} ({} convention{}) -> {}",

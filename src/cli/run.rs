@@ -55,7 +55,7 @@ pub struct Args {
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let (case, mut engine) = a.common.load()?;
     print_contact_summary(&case);
-    let tag = format!("{}:{}", case.name, engine.state().particles.len());
+    let tag = checkpoint::tag(&case);
     if let Some(ck) = &a.resume {
         checkpoint::read(ck, engine.as_mut(), &tag)?;
         println!(

@@ -12,9 +12,23 @@
 //! contact is written twice (i j, then j i with n and t negated), a free–wall contact once, free
 //! particle first.
 
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-use super::{fmt_f64, parse_numbers, FormatError};
+use super::{fmt_f64, parse_fields, parse_numbers, FormatError, Lines};
+
+/// The columns of a `.data` header line.
+const DATA_HEADER: [&str; 8] = ["N", "time", "xmin", "ymin", "zmin", "xmax", "ymax", "zmax"];
+/// The columns of a `.data` particle line.
+const DATA_COLUMNS: [&str; 14] = [
+    "rx", "ry", "rz", "vx", "vy", "vz", "radius", "alpha", "beta", "gamma", "omegax", "omegay",
+    "omegaz", "info",
+];
+/// The columns of an `.fstat` contact line.
+const FSTAT_COLUMNS: [&str; 16] = [
+    "time", "i", "j", "cx", "cy", "cz", "delta", "deltat", "fn", "ft", "nx", "ny", "nz", "tx",
+    "ty", "tz",
+];
 use crate::contact::PairInput;
 use crate::state::Domain;
 use crate::state::Motion;
@@ -145,6 +159,8 @@ pub struct DataRow {
     pub v: Vec3,
     pub radius: f64,
     pub w: Vec3,
+    /// Its line in the file (from 1), for messages.
+    pub line: usize,
 }
 
 /// A parsed `.data` file.
@@ -156,76 +172,106 @@ pub struct DataFile {
     pub rows: Vec<DataRow>,
 }
 
-/// Reads a MercuryCG `.data` file; any precision is accepted. Errors name the file and line:
-/// wrong column count, a header count that does not match the lines, a non-number, NaN.
+/// Reads a MercuryCG `.data` file line by line; any precision is accepted. See [`parse_data`].
 pub fn read_data(path: &Path) -> Result<DataFile, FormatError> {
-    let (file, text) = super::read_text(path)?;
-    let mut lines = text.lines().enumerate();
+    parse_data(&mut super::open(path)?)
+}
+
+/// Parses a MercuryCG `.data` file. Errors name the file, the line and the field: a header that
+/// is not `N time xmin ymin zmin xmax ymax zmax` with a whole N and a box of positive lengths, a
+/// particle line without 14 numbers (13 are accepted: MercuryDPM omits `info` in some
+/// versions), a non-number, NaN or an infinity, a radius that is not positive, more or fewer
+/// particle lines than N, bytes that are not UTF-8.
+pub fn parse_data<R: BufRead>(lines: &mut Lines<R>) -> Result<DataFile, FormatError> {
+    let file = lines.file().to_string();
     let mut nums = Vec::new();
-    let (_, head) = lines.next().ok_or_else(|| FormatError {
-        file: file.clone(),
-        line: 1,
-        msg: "empty file".into(),
-    })?;
-    parse_numbers(&file, 1, head, &mut nums)?;
-    if nums.len() != 8 || nums[0] < 0.0 || nums[0].fract() != 0.0 {
-        return Err(FormatError {
-            file,
-            line: 1,
-            msg: format!(
+    let Some((head_line, head)) = lines.next_nonblank()? else {
+        return Err(lines.error(
+            1,
+            "empty file: expected the header `N time xmin ymin zmin xmax ymax zmax`",
+        ));
+    };
+    parse_fields(&file, head_line, head, &DATA_HEADER, &mut nums)?;
+    if nums.len() != 8 {
+        return Err(lines.error(
+            head_line,
+            format!(
                 "header must be `N time xmin ymin zmin xmax ymax zmax` (8 numbers), got {} values",
                 nums.len()
             ),
-        });
+        ));
     }
-    let n = nums[0] as usize;
+    let n = super::count(&file, head_line, "N (particles)", nums[0])?;
+    let lo = Vec3::new(nums[2], nums[3], nums[4]);
+    let hi = Vec3::new(nums[5], nums[6], nums[7]);
+    check_box_lengths(&file, head_line, &lo, &hi)?;
     let mut out = DataFile {
         time: nums[1],
-        domain_lo: Vec3::new(nums[2], nums[3], nums[4]),
-        domain_hi: Vec3::new(nums[5], nums[6], nums[7]),
-        rows: Vec::with_capacity(n),
+        domain_lo: lo,
+        domain_hi: hi,
+        rows: Vec::with_capacity(super::reserve(n)),
     };
-    for (idx, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let line_no = idx + 1;
-        parse_numbers(&file, line_no, line, &mut nums)?;
+    while let Some((line_no, line)) = lines.next_nonblank()? {
+        parse_fields(&file, line_no, line, &DATA_COLUMNS, &mut nums)?;
         if nums.len() != 14 && nums.len() != 13 {
-            return Err(FormatError {
-                file,
-                line: line_no,
-                msg: format!(
+            return Err(lines.error(
+                line_no,
+                format!(
                     "expected 14 columns (rx ry rz vx vy vz radius alpha beta gamma omegax omegay omegaz info), got {}",
                     nums.len()
                 ),
-            });
+            ));
         }
         if out.rows.len() == n {
-            return Err(FormatError {
-                file,
-                line: line_no,
-                msg: format!("more particle lines than the {n} announced in the header"),
-            });
+            return Err(lines.error(
+                line_no,
+                format!(
+                    "more particle lines than the {n} announced in the header (line {head_line})"
+                ),
+            ));
+        }
+        if nums[6] <= 0.0 {
+            return Err(lines.error(
+                line_no,
+                format!("column 7 (radius): must be > 0, got {}", nums[6]),
+            ));
         }
         out.rows.push(DataRow {
             x: Vec3::new(nums[0], nums[1], nums[2]),
             v: Vec3::new(nums[3], nums[4], nums[5]),
             radius: nums[6],
             w: Vec3::new(nums[10], nums[11], nums[12]),
+            line: line_no,
         });
     }
     if out.rows.len() != n {
-        return Err(FormatError {
-            file,
-            line: text.lines().count(),
-            msg: format!(
+        return Err(lines.error(
+            lines.line().max(1),
+            format!(
                 "header announces {n} particles but the file has {} (truncated?)",
                 out.rows.len()
             ),
-        });
+        ));
     }
     Ok(out)
+}
+
+/// Refuses a box with a length that is not positive.
+fn check_box_lengths(file: &str, line: usize, lo: &Vec3, hi: &Vec3) -> Result<(), FormatError> {
+    match (0..3).find(|&k| hi[k] <= lo[k]) {
+        Some(k) => Err(FormatError {
+            file: file.into(),
+            line,
+            msg: format!(
+                "box: {} max {} is not above {} min {}",
+                ["x", "y", "z"][k],
+                hi[k],
+                ["x", "y", "z"][k],
+                lo[k]
+            ),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// One contact line of an `.fstat` file.
@@ -249,44 +295,107 @@ pub struct FstatFile {
     pub rows: Vec<FstatRow>,
 }
 
-/// Reads an `.fstat` file (three `#` lines, then 16 columns per contact line).
+/// Reads an `.fstat` file line by line. See [`parse_fstat`].
 pub fn read_fstat(path: &Path) -> Result<FstatFile, FormatError> {
-    let (file, text) = super::read_text(path)?;
+    parse_fstat(&mut super::open(path)?, None)
+}
+
+/// Reads the `.data` and `.fstat` files of one save, and checks that every contact's indices
+/// are particles of the `.data` file.
+pub fn read_save(data: &Path, fstat: &Path) -> Result<(DataFile, FstatFile), FormatError> {
+    let d = read_data(data)?;
+    let f = parse_fstat(&mut super::open(fstat)?, Some(d.rows.len()))?;
+    Ok((d, f))
+}
+
+/// Parses an `.fstat` file: three `#` header lines (`# time …`, the box, the radii), then 16
+/// numbers per contact line, `time i j …`. Errors name the file, the line and the field: a
+/// missing header, a line with other columns, a non-number, NaN or an infinity, indices that
+/// are not whole numbers or are equal, a time other than the header's, a second header after
+/// contact lines (one save per file), and with `particles` an index beyond the particles.
+pub fn parse_fstat<R: BufRead>(
+    lines: &mut Lines<R>,
+    particles: Option<usize>,
+) -> Result<FstatFile, FormatError> {
+    let file = lines.file().to_string();
+    let mut nums = Vec::new();
     let mut out = FstatFile {
-        time: f64::NAN,
+        time: 0.0,
         rows: Vec::new(),
     };
-    let mut nums = Vec::new();
-    for (idx, line) in text.lines().enumerate() {
-        let line_no = idx + 1;
-        if let Some(rest) = line.strip_prefix('#') {
-            if idx == 0 {
-                parse_numbers(&file, line_no, rest, &mut nums)?;
-                out.time = *nums.first().ok_or_else(|| FormatError {
-                    file: file.clone(),
-                    line: 1,
-                    msg: "first line must be `# time ...`".into(),
-                })?;
-            }
-            continue;
+    let headers = [
+        ("`# time ...`", 1),
+        ("`# xmin ymin zmin xmax ymax zmax`", 6),
+        ("`# rmin rmax ...`", 2),
+    ];
+    for (k, (what, least)) in headers.into_iter().enumerate() {
+        let line = match lines.next_line()? {
+            Some((_, l)) => l.strip_prefix('#'),
+            None => None,
+        };
+        let line_no = k + 1;
+        let Some(rest) = line else {
+            return Err(lines.error(line_no, format!("header line {line_no} must be {what}")));
+        };
+        parse_numbers(&file, line_no, rest, &mut nums)?;
+        if nums.len() < least {
+            return Err(lines.error(
+                line_no,
+                format!(
+                    "header line {line_no} must be {what} (at least {least} numbers), got {}",
+                    nums.len()
+                ),
+            ));
         }
-        if line.trim().is_empty() {
-            continue;
+        if k == 0 {
+            out.time = nums[0];
         }
-        parse_numbers(&file, line_no, line, &mut nums)?;
+    }
+    while let Some((line_no, line)) = lines.next_nonblank()? {
+        if line.starts_with('#') {
+            return Err(lines.error(
+                line_no,
+                "a second header after contact lines: one save per file expected",
+            ));
+        }
+        parse_fields(&file, line_no, line, &FSTAT_COLUMNS, &mut nums)?;
         if nums.len() != 16 {
-            return Err(FormatError {
-                file,
-                line: line_no,
-                msg: format!(
+            return Err(lines.error(
+                line_no,
+                format!(
                     "expected 16 columns (time i j cx cy cz delta deltat fn ft nx ny nz tx ty tz), got {}",
                     nums.len()
                 ),
-            });
+            ));
+        }
+        if (nums[0] - out.time).abs() > 1e-9 * out.time.abs().max(1.0) {
+            return Err(lines.error(
+                line_no,
+                format!(
+                    "column 1 (time): {} differs from the header's {} (a contact of another save?)",
+                    nums[0], out.time
+                ),
+            ));
+        }
+        let i = super::count(&file, line_no, "column 2 (i)", nums[1])?;
+        let j = super::count(&file, line_no, "column 3 (j)", nums[2])?;
+        if i == j {
+            return Err(lines.error(
+                line_no,
+                format!("columns 2, 3 (i, j): a contact of particle {i} with itself"),
+            ));
+        }
+        if let Some(n) = particles {
+            if let Some((col, k)) = [(2, i), (3, j)].into_iter().find(|&(_, k)| k >= n) {
+                return Err(lines.error(
+                    line_no,
+                    format!("column {col}: particle index {k} is not among the save's {n} particles (0..{})", n.saturating_sub(1)),
+                ));
+            }
         }
         out.rows.push(FstatRow {
-            i: nums[1] as usize,
-            j: nums[2] as usize,
+            i,
+            j,
             c: Vec3::new(nums[3], nums[4], nums[5]),
             delta: nums[6],
             deltat: nums[7],
@@ -294,13 +403,6 @@ pub fn read_fstat(path: &Path) -> Result<FstatFile, FormatError> {
             ft: nums[9],
             n: Vec3::new(nums[10], nums[11], nums[12]),
             t: Vec3::new(nums[13], nums[14], nums[15]),
-        });
-    }
-    if out.time.is_nan() {
-        return Err(FormatError {
-            file,
-            line: 1,
-            msg: "missing `# time` header line".into(),
         });
     }
     Ok(out)

@@ -10,13 +10,27 @@ pub mod mercury;
 pub mod official;
 pub mod vtk;
 
-/// A malformed input file: `file:line: message`.
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+/// A malformed input file: `file:line: message` (`file: message` when no line applies, as
+/// for a file that cannot be opened).
 #[derive(Debug, thiserror::Error)]
-#[error("{file}:{line}: {msg}")]
 pub struct FormatError {
     pub file: String,
+    /// Line (from 1), or 0 when the error is not on one line.
     pub line: usize,
     pub msg: String,
+}
+
+impl std::fmt::Display for FormatError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.line {
+            0 => write!(f, "{}: {}", self.file, self.msg),
+            line => write!(f, "{}:{line}: {}", self.file, self.msg),
+        }
+    }
 }
 
 /// Formats an f64 so that it reads back to the same bits: plain decimal for moderate
@@ -31,15 +45,174 @@ pub fn fmt_f64(out: &mut String, v: f64) {
     }
 }
 
-/// Reads a text file; returns its name (for messages) and its text.
-pub fn read_text(path: &std::path::Path) -> Result<(String, String), FormatError> {
+/// Reads a text file whole; returns its name (for messages) and its text. Bytes that are not
+/// UTF-8 are an error naming their line.
+pub fn read_text(path: &Path) -> Result<(String, String), FormatError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FormatError {
+    let bytes = std::fs::read(path).map_err(|e| FormatError {
         file: file.clone(),
         line: 0,
         msg: format!("cannot read: {e}"),
     })?;
+    let text = utf8(&file, bytes)?;
     Ok((file, text))
+}
+
+/// The text of the bytes of `file`, or an error naming the first line that is not UTF-8.
+pub fn utf8(file: &str, bytes: Vec<u8>) -> Result<String, FormatError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let line_start = bytes[..at]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |k| k + 1);
+        FormatError {
+            file: file.into(),
+            line: 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count(),
+            msg: not_utf8(at - line_start, bytes[at]),
+        }
+    })
+}
+
+/// The message for byte `byte`, at offset `at` (from 0) of its line, that is not UTF-8.
+fn not_utf8(at: usize, byte: u8) -> String {
+    format!(
+        "not UTF-8 text: byte 0x{byte:02x} at byte {} of the line (a binary or differently \
+         encoded file?)",
+        at + 1
+    )
+}
+
+/// Opens a text file to be read line by line with [`Lines`].
+pub fn open(path: &Path) -> Result<Lines<BufReader<File>>, FormatError> {
+    let file = path.display().to_string();
+    let f = File::open(path).map_err(|e| FormatError {
+        file: file.clone(),
+        line: 0,
+        msg: format!("cannot read: {e}"),
+    })?;
+    Ok(Lines::new(&file, BufReader::new(f)))
+}
+
+/// The lines of a text stream, one at a time (a file is never held whole), numbered from 1,
+/// without their `\n` or `\r\n`. A line that is not UTF-8 or cannot be read is an error naming
+/// the file and the line.
+pub struct Lines<R> {
+    file: String,
+    reader: R,
+    buf: Vec<u8>,
+    line: usize,
+}
+
+impl<R: BufRead> Lines<R> {
+    /// Lines of `reader`, reported as those of `file`.
+    pub fn new(file: &str, reader: R) -> Self {
+        Lines {
+            file: file.into(),
+            reader,
+            buf: Vec::new(),
+            line: 0,
+        }
+    }
+
+    /// The file's name, for messages.
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The number of the line last returned (0 before the first).
+    pub fn line(&self) -> usize {
+        self.line
+    }
+
+    /// An error at line `line` of this file.
+    pub fn error(&self, line: usize, msg: impl Into<String>) -> FormatError {
+        FormatError {
+            file: self.file.clone(),
+            line,
+            msg: msg.into(),
+        }
+    }
+
+    /// The next bytes of the stream, not consumed: before the first line, its first bytes (to
+    /// tell formats apart).
+    pub fn peek(&mut self) -> Result<&[u8], FormatError> {
+        let file = &self.file;
+        self.reader.fill_buf().map_err(|e| FormatError {
+            file: file.clone(),
+            line: 1,
+            msg: format!("cannot read: {e}"),
+        })
+    }
+
+    /// The next line and its number, `None` at the end of the stream.
+    pub fn next_line(&mut self) -> Result<Option<(usize, &str)>, FormatError> {
+        self.buf.clear();
+        let read = self.reader.read_until(b'\n', &mut self.buf);
+        self.line += 1;
+        match read {
+            Ok(0) => {
+                self.line -= 1;
+                return Ok(None);
+            }
+            Ok(_) => {}
+            Err(e) => return Err(self.error(self.line, format!("cannot read: {e}"))),
+        }
+        for end in [b'\n', b'\r'] {
+            if self.buf.last() == Some(&end) {
+                self.buf.pop();
+            }
+        }
+        match std::str::from_utf8(&self.buf) {
+            Ok(s) => Ok(Some((self.line, s))),
+            Err(e) => {
+                let at = e.valid_up_to();
+                Err(self.error(self.line, not_utf8(at, self.buf[at])))
+            }
+        }
+    }
+
+    /// The next line that is not blank, `None` at the end of the stream.
+    pub fn next_nonblank(&mut self) -> Result<Option<(usize, &str)>, FormatError> {
+        loop {
+            // Two look-ups keep the borrow checker content with the early return.
+            match self.next_line()? {
+                None => return Ok(None),
+                Some((_, l)) if l.trim().is_empty() => continue,
+                Some(_) => break,
+            }
+        }
+        let line = self.line;
+        Ok(Some((
+            line,
+            std::str::from_utf8(&self.buf).unwrap_or_default(),
+        )))
+    }
+}
+
+/// A count read as a number (a header's `N`): a whole number from 0 to 2^53, else an error
+/// naming `field`.
+pub fn count(file: &str, line: usize, field: &str, v: f64) -> Result<usize, FormatError> {
+    if v >= 0.0 && v.fract() == 0.0 && v <= 2f64.powi(53) {
+        Ok(v as usize)
+    } else {
+        Err(FormatError {
+            file: file.into(),
+            line,
+            msg: {
+                let mut got = String::new();
+                fmt_f64(&mut got, v);
+                format!("{field}: expected a whole number >= 0, got {got}")
+            },
+        })
+    }
+}
+
+/// Room to reserve for `n` announced items: no more than a modest number, so that a header
+/// announcing absurdly many costs nothing before the lines show it wrong.
+pub fn reserve(n: usize) -> usize {
+    n.min(1 << 16)
 }
 
 /// Parses whitespace-separated numbers of one line, naming file and line on failure; NaN and
@@ -50,18 +223,33 @@ pub fn parse_numbers(
     line: &str,
     out: &mut Vec<f64>,
 ) -> Result<(), FormatError> {
+    parse_fields(file, line_no, line, &[], out)
+}
+
+/// As [`parse_numbers`], naming column k `names[k]` in messages when there is such a name.
+pub fn parse_fields(
+    file: &str,
+    line_no: usize,
+    line: &str,
+    names: &[&str],
+    out: &mut Vec<f64>,
+) -> Result<(), FormatError> {
     out.clear();
     for (col, tok) in line.split_whitespace().enumerate() {
+        let column = match names.get(col) {
+            Some(name) => format!("column {} ({name})", col + 1),
+            None => format!("column {}", col + 1),
+        };
         let v: f64 = tok.parse().map_err(|_| FormatError {
             file: file.into(),
             line: line_no,
-            msg: format!("column {}: not a number: {tok:?}", col + 1),
+            msg: format!("{column}: not a number: {tok:?}"),
         })?;
         if !v.is_finite() {
             return Err(FormatError {
                 file: file.into(),
                 line: line_no,
-                msg: format!("column {}: not finite: {tok:?}", col + 1),
+                msg: format!("{column}: not finite: {tok:?} (expected a finite number)"),
             });
         }
         out.push(v);
@@ -90,6 +278,9 @@ mod tests {
     fn nan_is_rejected_with_file_and_line() {
         let mut v = Vec::new();
         let e = parse_numbers("a.data", 7, "1 2 nan", &mut v).unwrap_err();
-        assert_eq!(e.to_string(), "a.data:7: column 3: not finite: \"nan\"");
+        assert_eq!(
+            e.to_string(),
+            "a.data:7: column 3: not finite: \"nan\" (expected a finite number)"
+        );
     }
 }

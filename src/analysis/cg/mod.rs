@@ -276,8 +276,8 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     let per: Vec<anyhow::Result<(Raw, [crate::Vec3; 2])>> = saves
         .par_iter()
         .map(|&k| {
-            let data = mercury::read_data(&series.path("data", k))?;
-            let fstat = mercury::read_fstat(&series.path("fstat", k))?;
+            let (data, fstat) =
+                mercury::read_save(&series.path("data", k), &series.path("fstat", k))?;
             if data.rows.len() != head.rows.len() {
                 bail!(
                     "{}: {} particles, save {} has {}",

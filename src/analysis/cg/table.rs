@@ -81,6 +81,12 @@ impl Table {
                     format!("field {}: not a number: {tok:?}", field_name(col)),
                 )
             })?;
+            if let Some(col) = row.iter().position(|v| !v.is_finite()) {
+                return Err(fail(
+                    line_no,
+                    format!("field {}: not finite: {:?}", field_name(col), &record[col]),
+                ));
+            }
             if row.len() != 1 + 2 * COLUMNS.len() {
                 return Err(fail(
                     line_no,

@@ -2,90 +2,156 @@
 //! x y z vx vy vz omegax omegay omegaz`, sorted by id, 17 significant digits) and contacts
 //! (`dump local`).
 
+use std::io::BufRead;
 use std::path::Path;
 
 use super::DUMP_COLUMNS;
-use crate::io::{parse_numbers, read_text, FormatError};
+use crate::io::{parse_fields, parse_numbers, FormatError, Lines};
 use crate::peers::Frame;
 use crate::Vec3;
 
-fn err(file: &str, line: usize, msg: impl Into<String>) -> FormatError {
+fn err(file: &str, line: usize, msg: String) -> FormatError {
     FormatError {
         file: file.into(),
         line,
-        msg: msg.into(),
+        msg,
     }
 }
 
 /// A dump's header and its table: the step, the `ITEM:` line that names the columns, and the
 /// `count_item` rows of `columns` numbers each that follow it (line 10 on).
 struct Table {
+    file: String,
     step: u64,
     names: String,
     rows: Vec<Vec<f64>>,
+    /// The line of each row.
+    line: Vec<usize>,
 }
 
 /// Reads the header (`ITEM: TIMESTEP`, `count_item`, the box, `rows_item`) and the rows of a
-/// LAMMPS-style dump, naming the file and line of anything out of place.
-fn read_table(
-    path: &Path,
+/// LAMMPS-style dump line by line, naming the file, the line and the item of anything out of
+/// place: a missing `ITEM:` line, a step or count that is not a whole number, a box line
+/// without two finite bounds, a row without `columns` numbers, NaN or an infinity, fewer rows
+/// than announced, anything but blank lines after them, bytes that are not UTF-8.
+fn read_table<R: BufRead>(
+    lines: &mut Lines<R>,
     count_item: &str,
     rows_item: &str,
     columns: usize,
-) -> Result<(String, Table), FormatError> {
-    let (file, text) = read_text(path)?;
-    let lines: Vec<&str> = text.lines().collect();
-    let item = |k: usize, name: &str| -> Result<&str, FormatError> {
-        match lines.get(k) {
-            Some(l) if l.starts_with(name) => Ok(*l),
-            _ => Err(err(&file, k + 1, format!("expected `{name}`"))),
+) -> Result<Table, FormatError> {
+    let file = lines.file().to_string();
+    let item = |lines: &mut Lines<R>, name: &str| -> Result<String, FormatError> {
+        match lines.next_line()? {
+            Some((_, l)) if l.starts_with(name) => Ok(l.to_string()),
+            Some((k, l)) => Err(err(
+                &file,
+                k,
+                format!("expected `{name}`, got `{}`", l.trim()),
+            )),
+            None => Err(lines.error(
+                lines.line() + 1,
+                format!("expected `{name}` (truncated file?)"),
+            )),
         }
     };
-    let number = |k: usize| -> Result<u64, FormatError> {
-        lines
-            .get(k)
-            .and_then(|l| l.trim().parse().ok())
-            .ok_or_else(|| err(&file, k + 1, "expected a whole number"))
+    let number = |lines: &mut Lines<R>, what: &str| -> Result<u64, FormatError> {
+        match lines.next_line()? {
+            Some((k, l)) => l.trim().parse().map_err(|_| {
+                err(
+                    &file,
+                    k,
+                    format!("{what}: expected a whole number, got `{}`", l.trim()),
+                )
+            }),
+            None => Err(lines.error(
+                lines.line() + 1,
+                format!("{what}: expected a whole number (truncated file?)"),
+            )),
+        }
     };
-    item(0, "ITEM: TIMESTEP")?;
-    let step = number(1)?;
-    item(2, count_item)?;
-    let n = number(3)? as usize;
-    item(4, "ITEM: BOX BOUNDS")?;
-    let names = item(8, rows_item)?.to_string();
-    let mut rows = Vec::with_capacity(n);
+    item(lines, "ITEM: TIMESTEP")?;
+    let step = number(lines, "ITEM: TIMESTEP")?;
+    item(lines, count_item)?;
+    let n = number(lines, count_item)?;
+    let n =
+        usize::try_from(n).map_err(|_| lines.error(4, format!("{count_item}: {n} is too many")))?;
+    item(lines, "ITEM: BOX BOUNDS")?;
     let mut nums = Vec::new();
+    for axis in ["x", "y", "z"] {
+        match lines.next_line()? {
+            Some((k, l)) => {
+                parse_numbers(&file, k, l, &mut nums)?;
+                if nums.len() < 2 || nums[1] < nums[0] {
+                    return Err(lines.error(
+                        k,
+                        format!("ITEM: BOX BOUNDS: expected `{axis}lo {axis}hi` with {axis}lo <= {axis}hi"),
+                    ));
+                }
+            }
+            None => {
+                return Err(lines.error(
+                    lines.line() + 1,
+                    format!("ITEM: BOX BOUNDS: expected `{axis}lo {axis}hi` (truncated file?)"),
+                ))
+            }
+        }
+    }
+    let names = item(lines, rows_item)?;
+    let column_names: Vec<&str> = names.split_whitespace().skip(2).collect();
+    let mut rows = Vec::with_capacity(crate::io::reserve(n));
+    let mut line = Vec::with_capacity(crate::io::reserve(n));
     for e in 0..n {
-        let k = 9 + e;
-        let line = lines
-            .get(k)
-            .ok_or_else(|| err(&file, k + 1, format!("{n} rows announced, {e} found")))?;
-        parse_numbers(&file, k + 1, line, &mut nums)?;
-        if nums.len() != columns {
-            return Err(err(
-                &file,
-                k + 1,
-                format!("expected {columns} columns, got {}", nums.len()),
+        let Some((k, l)) = lines.next_line()? else {
+            return Err(lines.error(
+                lines.line() + 1,
+                format!("{n} rows announced ({count_item}), {e} found (truncated file?)"),
             ));
+        };
+        parse_fields(&file, k, l, &column_names, &mut nums)?;
+        if nums.len() != columns {
+            return Err(lines.error(k, format!("expected {columns} columns, got {}", nums.len())));
         }
         rows.push(nums.clone());
+        line.push(k);
     }
-    Ok((file, Table { step, names, rows }))
+    if let Some((k, _)) = lines.next_nonblank()? {
+        return Err(lines.error(
+            k,
+            format!("more lines than the {n} rows announced ({count_item}): one frame per file expected"),
+        ));
+    }
+    Ok(Table {
+        file,
+        step,
+        names,
+        rows,
+        line,
+    })
 }
 
-/// Reads a dump file; errors name the file and line (a missing `ITEM:` line, other columns,
-/// ids not 1…N in order, a non-number).
+/// Reads a dump file line by line. See [`parse`].
 pub fn read(path: &Path) -> Result<Frame, FormatError> {
-    let (file, t) = read_table(
-        path,
+    parse(&mut crate::io::open(path)?)
+}
+
+/// Parses a dump of one frame; errors name the file and line (those of `read_table`, other
+/// columns than [`DUMP_COLUMNS`], ids not 1…N in order, a radius that is not positive).
+pub fn parse<R: BufRead>(lines: &mut Lines<R>) -> Result<Frame, FormatError> {
+    let t = read_table(
+        lines,
         "ITEM: NUMBER OF ATOMS",
         "ITEM: ATOMS",
         DUMP_COLUMNS.len(),
     )?;
+    let err = |line: usize, msg: String| FormatError {
+        file: t.file.clone(),
+        line,
+        msg,
+    };
     let cols: Vec<&str> = t.names.split_whitespace().skip(2).collect();
     if cols != DUMP_COLUMNS {
         return Err(err(
-            &file,
             9,
             format!("columns must be `{}`", DUMP_COLUMNS.join(" ")),
         ));
@@ -101,14 +167,12 @@ pub fn read(path: &Path) -> Result<Frame, FormatError> {
     for (a, r) in t.rows.iter().enumerate() {
         if r[0] != (a + 1) as f64 {
             return Err(err(
-                &file,
-                10 + a,
-                format!(
-                    "expected atom {} with {} columns",
-                    a + 1,
-                    DUMP_COLUMNS.len()
-                ),
+                t.line[a],
+                format!("id: expected {} (sorted ids 1..N), got {}", a + 1, r[0]),
             ));
+        }
+        if r[2] <= 0.0 {
+            return Err(err(t.line[a], format!("radius: must be > 0, got {}", r[2])));
         }
         frame.radius.push(r[2]);
         frame.x.push(Vec3::new(r[3], r[4], r[5]));
@@ -120,7 +184,15 @@ pub fn read(path: &Path) -> Result<Frame, FormatError> {
 
 /// Reads a `dump local` file of `columns` numbers per entry (the contact forces of a save).
 pub fn read_entries(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> {
-    let (_, t) = read_table(path, "ITEM: NUMBER OF ENTRIES", "ITEM: ENTRIES", columns)?;
+    parse_entries(&mut crate::io::open(path)?, columns)
+}
+
+/// Parses a `dump local` file of `columns` numbers per entry.
+pub fn parse_entries<R: BufRead>(
+    lines: &mut Lines<R>,
+    columns: usize,
+) -> Result<Vec<Vec<f64>>, FormatError> {
+    let t = read_table(lines, "ITEM: NUMBER OF ENTRIES", "ITEM: ENTRIES", columns)?;
     Ok(t.rows)
 }
 
@@ -145,7 +217,7 @@ mod tests {
         std::fs::write(&p, DUMP.replace("\n2 2 0.5", "\n3 2 0.5")).unwrap();
         let e = read(&p).unwrap_err().to_string();
         assert!(
-            e.ends_with("dump.500.txt:11: expected atom 2 with 12 columns"),
+            e.ends_with("dump.500.txt:11: id: expected 2 (sorted ids 1..N), got 3"),
             "{e}"
         );
 
