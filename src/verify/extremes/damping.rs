@@ -5,6 +5,7 @@
 use super::timestep::judge;
 use super::{g3, load, parse, set, stopped, Did, Inputs, MapRow};
 use crate::case::{Case, DomainSpec, Scene as SceneSpec, SphereSpec};
+use crate::stability::{critical_dt, Spring};
 use crate::step::Engine;
 
 pub const CASE: &str = "damping";
@@ -231,7 +232,13 @@ pub fn rows(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     let limit = (4.0 - (omega * dt).powi(2)) / (2.0 * dt) * meff;
     for factor in [0.9, 2.0] {
         let gamman = factor * limit;
-        let critical = super::theory::max_dt(kn, gamman, meff);
+        let critical = critical_dt(
+            meff,
+            Spring {
+                k: kn,
+                gamma: gamman,
+            },
+        );
         let stable = dt < critical;
         let mut case = base.clone();
         case.contact.gamman = gamman;

@@ -23,7 +23,6 @@ pub mod damping;
 pub mod friction;
 pub mod packing;
 pub mod scales;
-pub mod theory;
 pub mod timestep;
 
 use std::path::{Path, PathBuf};

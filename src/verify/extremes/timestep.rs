@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::{g3, load, parse, set, stopped, unset, Did, Inputs, MapRow};
 use crate::case::{Case, Scene as SceneSpec, SphereSpec};
+use crate::stability::{critical_dt, Spring};
 use crate::step::guard::Failure;
 use crate::verify::collision::{closed_form, collide_with_phase};
 
@@ -41,7 +42,11 @@ pub fn judge(stable: bool, trustworthy: bool, did: &Did) -> bool {
 /// values are beyond the scheme's stability limit.
 pub fn limit_per_tc(case: &Case, meff: f64) -> f64 {
     let tc = case.tc_free_free().unwrap_or(f64::NAN);
-    tc / super::theory::max_dt(case.contact.kn, case.contact.gamman, meff)
+    let spring = Spring {
+        k: case.contact.kn,
+        gamma: case.contact.gamman,
+    };
+    tc / critical_dt(meff, spring)
 }
 
 /// A collision measured over [`PHASES`] onset phases.
