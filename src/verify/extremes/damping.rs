@@ -3,7 +3,7 @@
 //! the scheme is unstable.
 
 use super::timestep::judge;
-use super::{g3, load, parse, set, stopped, Did, Inputs, MapRow};
+use super::{g3, load, set, stopped, Did, Inputs, MapRow};
 use crate::case::{Case, DomainSpec, Scene as SceneSpec, SphereSpec};
 use crate::stability::{critical_dt, Spring};
 use crate::step::Engine;
@@ -139,14 +139,7 @@ pub fn rows(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     // the onset and end of each contact move
     let bound = (omega * dt).powi(2) / 4.0;
     let measured = elastic(&base)?;
-    let did = match (
-        parse(&set(&text, "contact", "gamman", "0.0"), &path),
-        &measured,
-    ) {
-        ((_, Some(refused)), _) => refused,
-        (_, Ok(_)) => Did::Ran,
-        (_, Err(f)) => stopped(f),
-    };
+    let did = super::did(&set(&text, "contact", "gamman", "0.0"), &path, &measured);
     let (text_m, bounded) = match &measured {
         Ok((dev, change)) => (
             format!("max |E-E0|/E0 {}, change {}", g3(*dev), g3(*change)),
@@ -203,10 +196,7 @@ pub fn rows(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
                     rebound.abs() <= 1e-3 && fn_min < 0.0,
                 )
             };
-            let did = match parse(&t, &path) {
-                (_, Some(refused)) => refused,
-                _ => Did::Ran,
-            };
+            let did = super::did(&t, &path, &Ok::<(), crate::step::guard::Failure>(()));
             rows.push(MapRow {
                 case: CASE.into(),
                 parameter: format!(
@@ -246,11 +236,7 @@ pub fn rows(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         case.run.steps_per_collision = None;
         let outcome = pressed(&case)?;
         let t = set(&text, "contact", "gamman", &format!("{gamman:?}"));
-        let did = match (parse(&t, &path), &outcome) {
-            ((_, Some(refused)), _) => refused,
-            (_, Ok(_)) => Did::Ran,
-            (_, Err(f)) => stopped(f),
-        };
+        let did = super::did(&t, &path, &outcome);
         let (measured, trustworthy) = match &outcome {
             Ok(grew) => (
                 format!(

@@ -49,10 +49,7 @@ fn with_mu(text: &str, case: &Case, mu: f64) -> (String, Case) {
 
 /// What verdem's command line does with `text`.
 fn did(text: &str, path: &std::path::Path) -> Did {
-    match parse(text, path) {
-        (_, Some(refused)) => refused,
-        _ => Did::Ran,
-    }
+    super::did(text, path, &Ok::<(), crate::step::guard::Failure>(()))
 }
 
 /// The friction rows.
@@ -152,20 +149,21 @@ fn mu_changed(
     // the case with mu changed, as a user would edit it, then resumed
     let (t, _) = with_mu(text, base, mu_after);
     let (after, did) = match parse(&t, path) {
-        (_, Some(refused)) => (f64::NAN, refused),
-        (Some(mut case), None) => {
+        Err(refused) => (f64::NAN, refused),
+        Ok(accepted) => {
+            let mut case = accepted.case.clone();
             case.scene = sticking.scene.clone();
             let scene = crate::scene::build(&case, None)?;
             let mut resumed = super::engine_of(&case, scene);
             match checkpoint::read(&ck, resumed.as_mut(), &tag) {
                 Err(err) => (f64::NAN, Did::Refused(format!("{err:#}"))),
-                Ok(_) => match resumed.advance(1) {
-                    Ok(()) => (ratio(&resumed.snapshot()).unwrap_or(f64::NAN), Did::Ran),
-                    Err(f) => (f64::NAN, super::stopped(&f)),
-                },
+                Ok(_) => {
+                    let run = resumed.advance(1);
+                    let after = ratio(&resumed.snapshot()).filter(|_| run.is_ok());
+                    (after.unwrap_or(f64::NAN), accepted.after(&run))
+                }
             }
         }
-        (None, None) => unreachable!("parse gives a case or a refusal"),
     };
     Ok(MapRow {
         case: CASE.into(),

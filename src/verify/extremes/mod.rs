@@ -244,17 +244,43 @@ pub fn load(path: &Path) -> anyhow::Result<(String, Case)> {
     Ok((text, Case::load(path)?))
 }
 
-/// What verdem's command line does with the case text `text` (read as `path`): the parsed case
-/// and `None`, or the refusal.
-pub fn parse(text: &str, path: &Path) -> (Option<Case>, Option<Did>) {
+/// A case text the command line accepted, and its first warning.
+pub struct Accepted {
+    pub case: Case,
+    pub warning: Option<String>,
+}
+
+impl Accepted {
+    /// What verdem did with the accepted case whose run ended with `run`.
+    pub fn after<T>(&self, run: &Result<T, Failure>) -> Did {
+        match (run, &self.warning) {
+            (Err(f), _) => stopped(f),
+            (Ok(_), Some(w)) => Did::Warned(w.clone()),
+            (Ok(_), None) => Did::Ran,
+        }
+    }
+}
+
+/// What verdem's command line does with the case text `text` (read as `path`): the accepted
+/// case, or the refusal.
+pub fn parse(text: &str, path: &Path) -> Result<Accepted, Did> {
     match Case::parse(text, &path.display().to_string()) {
         Ok(mut case) => {
             case.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
             case.path = path.to_path_buf();
-            (Some(case), None)
+            Ok(Accepted {
+                warning: None,
+                case,
+            })
         }
-        Err(e) => (None, Some(Did::Refused(e.to_string()))),
+        Err(e) => Err(Did::Refused(e.to_string())),
     }
+}
+
+/// What verdem did with the case text `text` (read as `path`) whose run, when accepted, ended
+/// with `run`.
+pub fn did<T>(text: &str, path: &Path, run: &Result<T, Failure>) -> Did {
+    parse(text, path).map_or_else(|refused| refused, |a| a.after(run))
 }
 
 /// The first line of a guard failure, shortened to its step and quantity.

@@ -3,7 +3,7 @@
 
 use rand::{Rng, SeedableRng};
 
-use super::{g3, load, parse, set, stopped, Did, Inputs, MapRow};
+use super::{g3, load, set, stopped, Did, Inputs, MapRow};
 use crate::case::{DomainSpec, Scene as SceneSpec, Search};
 use crate::scene::Scene;
 use crate::state::{Domain, Motion, Particles};
@@ -59,11 +59,7 @@ pub fn gas(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     let outcome = e.advance(GAS_STEPS);
     let change = (totals(e.as_ref()).0 - p0).norm() / (mass * v_rms);
     let bound = 2.0 * GAS_STEPS as f64 * f64::EPSILON / 2.0 * v_max / v_rms;
-    let did = match (parse(&t, &path), &outcome) {
-        ((_, Some(refused)), _) => refused,
-        (_, Ok(())) => Did::Ran,
-        (_, Err(f)) => stopped(f),
-    };
+    let did = super::did(&t, &path, &outcome);
     Ok(vec![MapRow {
         case: GAS.into(),
         parameter: format!("{GAS_COUNT} spheres, {GAS_STEPS} steps, frictionless elastic"),
@@ -390,11 +386,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
             largest = largest.max(d - r.norm());
         }
     }
-    let did = match (parse(&t, &inputs.shear), &outcome) {
-        ((_, Some(refused)), _) => refused,
-        (_, Ok(())) => Did::Ran,
-        (_, Err(f)) => stopped(f),
-    };
+    let did = super::did(&t, &inputs.shear, &outcome);
     Ok(vec![MapRow {
         case: DENSE_SHEAR.into(),
         parameter: format!("{count} spheres, walls {SHEAR_GAP} apart, mean phi {SHEAR_FRACTION}"),

@@ -30,12 +30,8 @@ fn describe(s: &Sweep) -> (String, bool) {
 /// `v0` of the parsed case.
 fn did(text: &str, path: &std::path::Path, v0: f64) -> Did {
     match parse(text, path) {
-        (_, Some(refused)) => refused,
-        (Some(case), None) => match collide_with_phase(&case, v0, false, PER_TC, 0.5) {
-            Ok(_) => Did::Ran,
-            Err(e) => stopped(&failure(e)),
-        },
-        (None, None) => unreachable!("parse gives a case or a refusal"),
+        Err(refused) => refused,
+        Ok(a) => a.after(&collide_with_phase(&a.case, v0, false, PER_TC, 0.5).map_err(failure)),
     }
 }
 

@@ -137,12 +137,8 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
         );
         let measured = sweep(&base, wall, per_tc, 1.0);
         let did = match parse(&t, &path) {
-            (_, Some(refused)) => refused,
-            (Some(case), None) => match collide_with_phase(&case, 1.0, wall, per_tc, 0.5) {
-                Ok(_) => Did::Ran,
-                Err(e) => stopped(&failure(e)),
-            },
-            (None, None) => unreachable!("parse gives a case or a refusal"),
+            Err(refused) => refused,
+            Ok(a) => a.after(&collide_with_phase(&a.case, 1.0, wall, per_tc, 0.5).map_err(failure)),
         };
         let (text, trustworthy) = match &measured {
             Ok(s) => (
@@ -327,11 +323,7 @@ pub fn shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         );
         let measured = shear_run(&base, state, per_tc)?;
         // an accepted case is the base with this step: its run is the measured one
-        let did = match (parse(&t, &inputs.shear), &measured) {
-            ((_, Some(refused)), _) => refused,
-            (_, Ok(_)) => Did::Ran,
-            (_, Err(f)) => stopped(f),
-        };
+        let did = super::did(&t, &inputs.shear, &measured);
         rows.push(MapRow {
             case: SHEAR.into(),
             parameter: format!("tc/dt = {per_tc}"),
