@@ -152,17 +152,21 @@ pub fn map(inputs: &Inputs, only: Option<&str>) -> anyhow::Result<Vec<MapRow>> {
     Ok(rows)
 }
 
-/// The map as a fixed-width table.
+/// The map as text, a row a line: verdict, case, parameter, then theory, measurement and what
+/// verdem did separated by `|`.
 pub fn table(rows: &[MapRow]) -> String {
-    let mut s = String::new();
+    let mut s = format!(
+        "{:<6}{:<20} {:<40} | theory | measured | verdem\n",
+        "", "case", "parameter"
+    );
     for r in rows {
         s.push_str(&format!(
-            "{:<20} {:<32} {:<44} {:<56} {}  {}\n",
+            "{:<6}{:<20} {:<40} | {} | {} | {}\n",
+            r.verdict(),
             r.case,
             r.parameter,
             r.theory,
             r.measured,
-            r.verdict(),
             r.did.text()
         ));
     }

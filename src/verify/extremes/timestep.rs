@@ -111,10 +111,7 @@ fn collision_text(base_text: &str, wall: bool) -> String {
         return base_text.to_string();
     }
     // the second [[scene.sphere]] is the last table of the file
-    format!(
-        "{}fixed = true\n",
-        base_text.trim_end_matches('\n').to_string() + "\n"
-    )
+    format!("{}\nfixed = true\n", base_text.trim_end())
 }
 
 fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
