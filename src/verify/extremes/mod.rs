@@ -273,7 +273,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Accepted, Did> {
             case.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
             case.path = path.to_path_buf();
             Ok(Accepted {
-                warning: None,
+                warning: case.warnings().first().cloned(),
                 case,
             })
         }

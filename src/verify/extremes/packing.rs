@@ -15,9 +15,11 @@ pub const GAS: &str = "periodic gas";
 /// Spheres of the gas and its steps.
 pub const GAS_COUNT: usize = 4;
 pub const GAS_STEPS: u64 = 10_000_000;
+/// Edge of the gas's periodic box (room for the random fill's two layers).
+const GAS_EDGE: f64 = 3.5;
 
 /// The frictionless elastic gas of `conservation.toml` cut down to [`GAS_COUNT`] spheres in a
-/// periodic box of edge 3 for [`GAS_STEPS`] steps: the change of the total momentum relative
+/// periodic box of edge [`GAS_EDGE`] for [`GAS_STEPS`] steps: the change of the total momentum relative
 /// to M v_rms. Pair forces are equal and opposite, so only the rounding of the velocity
 /// updates moves it: at most ε|v| per particle and half-kick, 2 S ε v_max/v_rms relative.
 pub fn gas(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
@@ -28,7 +30,7 @@ pub fn gas(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     case.contact.mu = 0.0;
     case.domain = DomainSpec {
         lo: [0.0; 3],
-        hi: [3.0; 3],
+        hi: [GAS_EDGE; 3],
         periodic: [true; 3],
     };
     case.neighbor.search = Search::AllPairs;
@@ -38,7 +40,7 @@ pub fn gas(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     };
     let t = set(&text, "contact", "gamman", "0.0");
     let t = set(&t, "contact", "mu", "0.0");
-    let t = set(&t, "domain", "hi", "[3.0, 3.0, 3.0]");
+    let t = set(&t, "domain", "hi", &format!("{:?}", [GAS_EDGE; 3]));
     let t = set(&t, "neighbor", "search", "\"all-pairs\"");
     let t = set(&t, "scene", "count", &GAS_COUNT.to_string());
     let scene = crate::scene::build(&case, None)?;
@@ -349,9 +351,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     );
     let mut particles = Particles::default();
     let rho = base.material.density;
-    for p in x.iter().take(count) {
-        particles.push(*p, Vec3::zeros(), Vec3::zeros(), 0.5 * d, rho, Motion::Free);
-    }
+    // the order of a bumpy-shear file: the walls' spheres, then the free ones
     for (g, (w, vx)) in walls.iter().enumerate() {
         for p in w {
             let v = Vec3::new(*vx, 0.0, 0.0);
@@ -365,12 +365,42 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
             );
         }
     }
+    for p in x.iter().take(count) {
+        particles.push(*p, Vec3::zeros(), Vec3::zeros(), 0.5 * d, rho, Motion::Free);
+    }
     let scene = Scene {
         domain,
         particles,
         time: 0.0,
     };
-    let mut e = super::engine_of(&base, scene);
+    // the relaxed state as an initial file, which the case text names as a user's would
+    let relaxed = super::engine_of(&base, scene).snapshot();
+    std::fs::create_dir_all(&inputs.out)?;
+    let init = inputs.out.join("dense_shear.data");
+    crate::io::atomic::write(&init, crate::io::mercury::data_text(&relaxed).as_bytes())?;
+    let t = set(
+        &t,
+        "run",
+        "init",
+        &format!("{:?}", init.display().to_string()),
+    );
+    let accepted = super::parse(&t, &inputs.shear);
+    let mut case = base.clone();
+    if let Ok(a) = &accepted {
+        case = a.case.clone();
+    } else {
+        case.run.init = Some(init.display().to_string());
+        case.scene = crate::case::Scene::BumpyShear {
+            free: count,
+            wall_rows,
+            wall_per_row,
+            bottom_z,
+            top_z,
+            bottom_vx,
+            top_vx,
+        };
+    }
+    let mut e = super::engine_of(&case, crate::scene::build(&case, None)?);
     let mut largest = 0.0f64;
     let mut outcome = e.advance(0);
     for _ in 0..20 {
@@ -386,7 +416,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
             largest = largest.max(d - r.norm());
         }
     }
-    let did = super::did(&t, &inputs.shear, &outcome);
+    let did = accepted.map_or_else(|refused| refused, |a| a.after(&outcome));
     Ok(vec![MapRow {
         case: DENSE_SHEAR.into(),
         parameter: format!("{count} spheres, walls {SHEAR_GAP} apart, mean phi {SHEAR_FRACTION}"),

@@ -35,8 +35,9 @@ fn did(text: &str, path: &std::path::Path, v0: f64) -> Did {
     }
 }
 
-/// kn from 1e2 to 1e9 with γn ∝ √kn (same damping ratio, so the same restitution) at
-/// tc/dt = 50, free–free at speed 0.1; and the spread of the restitution over them.
+/// kn from 1e2 to 1e9 with γn ∝ √kn (same damping ratio, so the same restitution) and the
+/// tangential spring and dashpot scaled alike, at tc/dt = 50, free–free at speed 0.1; and the
+/// spread of the restitution over them.
 pub fn stiffness(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     let path = inputs.verify_dir.join("binary_collision.toml");
     let (text, base) = load(&path)?;
@@ -49,14 +50,18 @@ pub fn stiffness(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         let mut case: Case = base.clone();
         case.contact.kn = kn;
         case.contact.gamman *= scale;
+        case.contact.kt *= scale * scale;
+        case.contact.gammat *= scale;
         let cf = closed_form(&case, 0.5 * case.particle_mass());
         let t = set(&text, "contact", "kn", &format!("{kn:e}"));
-        let t = set(
-            &t,
-            "contact",
-            "gamman",
-            &format!("{:e}", case.contact.gamman),
-        );
+        let mut t = t;
+        for (key, v) in [
+            ("gamman", case.contact.gamman),
+            ("kt", case.contact.kt),
+            ("gammat", case.contact.gammat),
+        ] {
+            t = set(&t, "contact", key, &format!("{v:e}"));
+        }
         let (measured, trustworthy) = match sweep(&case, false, PER_TC, v0) {
             Ok(s) => {
                 restitutions.push(s.e_mean);
