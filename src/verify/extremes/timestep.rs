@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{g3, load, parse, set, stopped, unset, Did, Inputs, MapRow};
 use crate::case::{Case, Scene as SceneSpec, SphereSpec};
-use crate::stability::{critical_dt, Spring};
+use crate::stability::{critical_dt, restitution_error, Pair, Spring};
 use crate::step::guard::Failure;
 use crate::verify::collision::{closed_form, collide_with_phase};
 
@@ -121,7 +121,11 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
     let meff = if wall { m } else { 0.5 * m };
     let cf = closed_form(&base, meff);
     let limit = limit_per_tc(&base, meff);
-    let name = if wall { FREE_WALL } else { FREE_FREE };
+    let (name, pair) = if wall {
+        (FREE_WALL, Pair::FreeWall)
+    } else {
+        (FREE_FREE, Pair::FreeFree)
+    };
     let text = collision_text(&base_text, wall);
     let mut rows = Vec::new();
     for per_tc in PER_TC {
@@ -155,11 +159,13 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
         rows.push(MapRow {
             case: name.into(),
             parameter: format!("tc/dt = {per_tc}"),
+            // the restitution error a coarse step's warning names, for comparison
             theory: format!(
-                "e {:.4}, dmax {}; {} (limit {limit:.3})",
+                "e {:.4}, dmax {}; {} (limit {limit:.3}); estimated err {}",
                 cf.e,
                 g3(cf.delta_max_per_speed),
-                if stable { "stable" } else { "unstable" }
+                if stable { "stable" } else { "unstable" },
+                g3(restitution_error(pair, per_tc))
             ),
             measured: text,
             pass: judge(stable, trustworthy, &did),
