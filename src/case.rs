@@ -483,6 +483,25 @@ impl Case {
                         "walls need rows and spheres per row".into(),
                     ));
                 }
+                // rows along y at √3/2 d, spheres along x at d (scene::bumpy_wall): a wall
+                // wider than the box overlaps itself across the periodic seam or leaves it
+                let extent = [
+                    ("wall_per_row", *wall_per_row as f64 * d),
+                    ("wall_rows", *wall_rows as f64 * 3f64.sqrt() / 2.0 * d),
+                ];
+                for (k, (key, width)) in extent.into_iter().enumerate() {
+                    let l = hi[k] - lo[k];
+                    if width > l * (1.0 + 1e-9) {
+                        return Err(at.error(
+                            &format!("scene.{key}"),
+                            format!(
+                                "walls within the box: a width along {} of at most {l} \
+                                 expected, got {width}",
+                                axis[k]
+                            ),
+                        ));
+                    }
+                }
                 // the free spheres need a gap of one diameter between the two walls' spheres
                 if top_z - bottom_z < 2.0 * d {
                     return Err(at.error(

@@ -401,6 +401,23 @@ fn geometry_that_cannot_be_built() {
             "scene.top_z",
             "a wall inside the box",
         ),
+        // bumpy walls wider than the box: their spheres overlap across the periodic seam
+        bad(
+            QUICK,
+            "wall_rows = ",
+            "wall_rows = 13",
+            "wall_rows",
+            "scene.wall_rows",
+            "width along y",
+        ),
+        bad(
+            QUICK,
+            "wall_per_row = ",
+            "wall_per_row = 4000000000000000000",
+            "wall_per_row",
+            "scene.wall_per_row",
+            "at most 20",
+        ),
         // a box smaller than a sphere, a periodic length that makes a sphere touch two images
         bad(
             PAIR,
