@@ -165,6 +165,14 @@ fn malformed_toml_unknown_missing_and_mistyped_fields() {
             "missing field `kn`",
         ),
         bad(
+            PAIR,
+            "x = [0.5005",
+            "x = [0.5005, 0.0]",
+            "x = [0.5005",
+            "scene.sphere[1].x",
+            "invalid length 2",
+        ),
+        bad(
             QUICK,
             "name = ",
             "",
@@ -206,6 +214,29 @@ fn malformed_toml_unknown_missing_and_mistyped_fields() {
             "duplicate key",
         ),
     ]);
+}
+
+/// A key missing from the second element of an array of tables is named with its index, at
+/// that element's header.
+#[test]
+fn a_key_missing_from_an_array_element_names_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, text) = edited(dir.path(), PAIR, "x = [0.5005", "fixed = false");
+    let line = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| *l == "[[scene.sphere]]")
+        .nth(1)
+        .unwrap()
+        .0
+        + 1;
+    let (code, _, err) = run(&path);
+    assert_eq!(code, Some(1), "{err}");
+    let head = format!(
+        "{}:{line}: scene.sphere[1].x: missing field `x`",
+        path.display()
+    );
+    assert!(err.contains(&head), "{err}");
 }
 
 #[test]
