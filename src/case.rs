@@ -285,25 +285,35 @@ impl Case {
                 let unknown = msg
                     .strip_prefix("unknown field `")
                     .and_then(|m| m.split('`').next());
-                let found = match (unknown, offending_value(&msg)) {
-                    (Some(key), _) => find_under(text, &table, |k, _| k == key),
-                    (None, Some(value)) => find_under(text, &table, |_, v| same_value(v, value)),
-                    (None, None) => None,
+                let length = msg
+                    .strip_prefix("invalid length ")
+                    .and_then(|m| m.split(',').next()?.parse::<usize>().ok());
+                let found = match (unknown, offending_value(&msg), length) {
+                    (Some(key), _, _) => find_under(text, &table, |k, _| k == key),
+                    (None, Some(value), _) => find_under(text, &table, |_, v| same_value(v, value)),
+                    (None, None, Some(n)) => {
+                        find_under(text, &table, |_, v| array_of(v) == Some(n))
+                    }
+                    (None, None, None) => None,
                 };
                 if let Some(at) = found {
                     (line, field) = at;
                 }
             }
-            // A missing key is reported at its table's header: name the key.
+            // A missing key is reported at its table's header: name the key, and the element
+            // of an array of tables under it that lacks it.
             if let Some(key) = msg
                 .strip_prefix("missing field `")
                 .and_then(|m| m.split('`').next())
             {
-                field = if field == "-" {
-                    key.to_string()
-                } else {
-                    format!("{field}.{key}")
-                };
+                match lacking(text, &field, key) {
+                    Some(element) => {
+                        line = locate_path(text, &segments(&element));
+                        field = format!("{element}.{key}");
+                    }
+                    None if field == "-" => field = key.to_string(),
+                    None => field = format!("{field}.{key}"),
+                }
             }
             CaseError {
                 file: file.into(),
@@ -482,6 +492,25 @@ impl Case {
                         "scene.wall_rows",
                         "walls need rows and spheres per row".into(),
                     ));
+                }
+                // rows along y at √3/2 d, spheres along x at d (scene::bumpy_wall): a wall
+                // wider than the box overlaps itself across the periodic seam or leaves it
+                let extent = [
+                    ("wall_per_row", *wall_per_row as f64 * d),
+                    ("wall_rows", *wall_rows as f64 * 3f64.sqrt() / 2.0 * d),
+                ];
+                for (k, (key, width)) in extent.into_iter().enumerate() {
+                    let l = hi[k] - lo[k];
+                    if width > l * (1.0 + 1e-9) {
+                        return Err(at.error(
+                            &format!("scene.{key}"),
+                            format!(
+                                "walls within the box: a width along {} of at most {l} \
+                                 expected, got {width}",
+                                axis[k]
+                            ),
+                        ));
+                    }
                 }
                 // the free spheres need a gap of one diameter between the two walls' spheres
                 if top_z - bottom_z < 2.0 * d {
@@ -978,6 +1007,30 @@ fn find_under(
         return Some((n + 1, format!("{field}.{}", k.trim())));
     }
     None
+}
+
+/// The first element `table.name[i]` of an array of tables under `table` (a table's dotted
+/// name) that lacks `key`, when `table` itself has it or is not a table.
+fn lacking(text: &str, table: &str, key: &str) -> Option<String> {
+    let doc: toml::Value = toml::from_str(text).ok()?;
+    let mut t = &doc;
+    for k in table.split('.') {
+        t = t.get(k)?;
+    }
+    let t = t.as_table()?;
+    t.iter().find_map(|(name, v)| {
+        let elements = v.as_array()?;
+        let i = elements
+            .iter()
+            .position(|e| e.as_table().is_some_and(|e| !e.contains_key(key)))?;
+        Some(format!("{table}.{name}[{i}]"))
+    })
+}
+
+/// The length of the array a key line's value text holds, if it is one.
+fn array_of(text: &str) -> Option<usize> {
+    let v: toml::Value = toml::from_str(&format!("v = {text}")).ok()?;
+    v.get("v")?.as_array().map(Vec::len)
 }
 
 /// The value a serde "invalid type/value" message quotes: `2.5` of "invalid type: floating

@@ -165,6 +165,14 @@ fn malformed_toml_unknown_missing_and_mistyped_fields() {
             "missing field `kn`",
         ),
         bad(
+            PAIR,
+            "x = [0.5005",
+            "x = [0.5005, 0.0]",
+            "x = [0.5005",
+            "scene.sphere[1].x",
+            "invalid length 2",
+        ),
+        bad(
             QUICK,
             "name = ",
             "",
@@ -206,6 +214,29 @@ fn malformed_toml_unknown_missing_and_mistyped_fields() {
             "duplicate key",
         ),
     ]);
+}
+
+/// A key missing from the second element of an array of tables is named with its index, at
+/// that element's header.
+#[test]
+fn a_key_missing_from_an_array_element_names_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, text) = edited(dir.path(), PAIR, "x = [0.5005", "fixed = false");
+    let line = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| *l == "[[scene.sphere]]")
+        .nth(1)
+        .unwrap()
+        .0
+        + 1;
+    let (code, _, err) = run(&path);
+    assert_eq!(code, Some(1), "{err}");
+    let head = format!(
+        "{}:{line}: scene.sphere[1].x: missing field `x`",
+        path.display()
+    );
+    assert!(err.contains(&head), "{err}");
 }
 
 #[test]
@@ -400,6 +431,23 @@ fn geometry_that_cannot_be_built() {
             "top_z",
             "scene.top_z",
             "a wall inside the box",
+        ),
+        // bumpy walls wider than the box: their spheres overlap across the periodic seam
+        bad(
+            QUICK,
+            "wall_rows = ",
+            "wall_rows = 13",
+            "wall_rows",
+            "scene.wall_rows",
+            "width along y",
+        ),
+        bad(
+            QUICK,
+            "wall_per_row = ",
+            "wall_per_row = 4000000000000000000",
+            "wall_per_row",
+            "scene.wall_per_row",
+            "at most 20",
         ),
         // a box smaller than a sphere, a periodic length that makes a sphere touch two images
         bad(

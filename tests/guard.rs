@@ -97,8 +97,8 @@ fn coincident_spheres_are_stopped_before_anything_is_written() {
 
 /// dt = tc/1.3: within the stability limit of one free–wall contact (tc/1.137), which the case
 /// validation checks, but beyond that of a free sphere squeezed between two wall spheres (two
-/// springs at once: √2 times the frequency). The overlap grows ~1.7-fold a step; unstable runs
-/// used to end with exit status 0.
+/// springs at once: √2 times the frequency; the spectral radius of its step is 3.8). Unstable
+/// runs used to end with exit status 0.
 #[test]
 fn an_unstable_time_step_is_stopped_with_its_step_and_particles() {
     let dir = tempfile::tempdir().unwrap();
