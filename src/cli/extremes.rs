@@ -22,7 +22,8 @@ pub struct Args {
     /// Only the rows whose case and parameter contain this text.
     #[arg(long)]
     only: Option<String>,
-    /// Output folder (extremes.csv and the checkpoint of the friction rows).
+    /// Output folder: extremes.csv, the friction rows' checkpoint and the dense shear's
+    /// initial file.
     #[arg(long, default_value = "out/extremes")]
     out: PathBuf,
 }
