@@ -6,6 +6,11 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 pub use crate::contact::Tangential;
+use crate::stability::{self, Direction, Limit, Pair, Spring};
+
+/// Steps per free–free collision time below which a case is accepted with a warning naming the
+/// expected restitution error.
+pub const COARSE_STEPS_PER_COLLISION: f64 = 10.0;
 
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +45,9 @@ pub struct Case {
     /// Path the case was read from.
     #[serde(skip)]
     pub path: PathBuf,
+    /// What validation found acceptable but worth saying, as read (see [`Case::warnings`]).
+    #[serde(skip)]
+    warnings: Vec<String>,
 }
 
 /// `[run]`: time stepping and output.
@@ -263,13 +271,27 @@ pub struct SphereSpec {
 impl Case {
     /// Reads and validates a case file.
     pub fn load(path: &Path) -> Result<Case, CaseError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CaseError {
-            file: path.display().to_string(),
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| CaseError {
+            file: file.clone(),
             line: 0,
             field: "-".into(),
             msg: format!("cannot read: {e}"),
         })?;
-        let mut case = Case::parse(&text, &path.display().to_string())?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            CaseError {
+                file: file.clone(),
+                line: valid.iter().filter(|&&b| b == b'\n').count() + 1,
+                field: "-".into(),
+                msg: format!(
+                    "UTF-8 text expected, got the byte {:#04x} (byte {} of the file)",
+                    e.as_bytes()[valid.len()],
+                    valid.len() + 1
+                ),
+            }
+        })?;
+        let mut case = Case::parse(&text, &file)?;
         case.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         case.path = path.to_path_buf();
         Ok(case)
@@ -277,45 +299,81 @@ impl Case {
 
     /// Parses and validates case text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Case, CaseError> {
-        let case: Case = toml::from_str(text).map_err(|e| {
+        let mut case: Case = toml::from_str(text).map_err(|e| {
             let mut line = e
                 .span()
                 .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
                 .unwrap_or(0);
             let mut field = field_on_line(text, line);
             let msg = e.message().trim().to_string();
-            // A tagged table (`[scene]`) is read whole, and its error points at the header:
-            // find the unknown key in it.
-            let unknown = msg
-                .strip_prefix("unknown field `")
-                .and_then(|m| m.split('`').next());
-            if let (Some(key), Some(table)) = (unknown, table_header(text_line(text, line))) {
-                let at = locate(text, &table, key);
-                if at != line {
-                    (line, field) = (at, format!("{table}.{key}"));
+            // A tagged table (`[scene]`) is read whole, and its error points at the header: find
+            // the unknown key, or the key holding the value of the wrong type, in it.
+            if let Some(table) = table_header(text_line(text, line)) {
+                let unknown = msg
+                    .strip_prefix("unknown field `")
+                    .and_then(|m| m.split('`').next());
+                let length = msg
+                    .strip_prefix("invalid length ")
+                    .and_then(|m| m.split(',').next()?.parse::<usize>().ok());
+                let found = match (unknown, offending_value(&msg), length) {
+                    (Some(key), _, _) => find_under(text, &table, |k, _| k == key),
+                    (None, Some(value), _) => find_under(text, &table, |_, v| same_value(v, value)),
+                    (None, None, Some(n)) => {
+                        find_under(text, &table, |_, v| array_of(v) == Some(n))
+                    }
+                    (None, None, None) => None,
+                };
+                if let Some(at) = found {
+                    (line, field) = at;
+                }
+            }
+            // A missing key is reported at its table's header: name the key, and the element
+            // of an array of tables under it that lacks it.
+            if let Some(key) = msg
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split('`').next())
+            {
+                match lacking(text, &field, key) {
+                    Some(element) => {
+                        line = locate_path(text, &segments(&element));
+                        field = format!("{element}.{key}");
+                    }
+                    None if field == "-" => field = key.to_string(),
+                    None => field = format!("{field}.{key}"),
                 }
             }
             CaseError {
                 file: file.into(),
                 line,
                 field,
-                msg,
+                msg: msg.split('\n').collect::<Vec<_>>().join("; "),
             }
         })?;
-        case.validate(text, file)?;
+        let at = Locator { text, file };
+        if let Some((field, value)) = toml::from_str::<toml::Value>(text)
+            .ok()
+            .and_then(|v| non_finite(&v, ""))
+        {
+            return Err(at.error(&field, format!("a finite number expected, got {value}")));
+        }
+        case.warnings = case.validate(&at)?;
         Ok(case)
     }
 
-    fn validate(&self, text: &str, file: &str) -> Result<(), CaseError> {
-        let err = |table: &str, key: &str, msg: String| CaseError {
-            file: file.into(),
-            line: locate(text, table, key),
-            field: if table.is_empty() {
-                key.to_string()
+    /// What validation accepted with a warning (`file:line: field: message`), for the case as
+    /// read: a coarse time step and the restitution error it is expected to cost.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Checks what the schema cannot; returns the warnings.
+    fn validate(&self, at: &Locator<'_>) -> Result<Vec<String>, CaseError> {
+        let err = |table: &str, key: &str, msg: String| {
+            if table.is_empty() {
+                at.error(key, msg)
             } else {
-                format!("{table}.{key}")
-            },
-            msg,
+                at.error(&format!("{table}.{key}"), msg)
+            }
         };
         let positive = |table: &str, key: &str, v: f64| {
             if v > 0.0 && v.is_finite() {
@@ -391,10 +449,11 @@ impl Case {
         let c = &self.contact;
         positive("contact", "kn", c.kn)?;
         non_negative("contact", "gamman", c.gamman)?;
+        non_negative("contact", "kt", c.kt)?;
+        non_negative("contact", "gammat", c.gammat)?;
         non_negative("contact", "mu", c.mu)?;
         if c.mu > 0.0 {
             positive("contact", "kt", c.kt)?;
-            non_negative("contact", "gammat", c.gammat)?;
         }
         if self.tc_free_free().is_none() {
             return Err(err(
@@ -406,6 +465,43 @@ impl Case {
                 ),
             ));
         }
+        self.validate_scene(at)?;
+        self.validate_time_step(at)
+    }
+
+    /// The box against the spheres, the walls against each other and the box, the number of
+    /// spheres against the room the scene gives them, and the walls' prescribed velocities.
+    fn validate_scene(&self, at: &Locator<'_>) -> Result<(), CaseError> {
+        let (lo, hi, periodic) = (self.domain.lo, self.domain.hi, self.domain.periodic);
+        let d = self.material.diameter;
+        let axis = ["x", "y", "z"];
+        let (d_free, d_max) = self.largest_diameters();
+        for k in 0..3 {
+            let l = hi[k] - lo[k];
+            // minimum image: no sphere may touch two images of one neighbour
+            if periodic[k] && l <= 2.0 * d_max {
+                return Err(at.error(
+                    "domain.hi",
+                    format!(
+                        "a periodic length along {} above twice the largest sphere diameter \
+                         ({}) expected, got {l}",
+                        axis[k],
+                        2.0 * d_max
+                    ),
+                ));
+            }
+            if !periodic[k] && l < d_free {
+                return Err(at.error(
+                    "domain.hi",
+                    format!(
+                        "a box at least one free sphere's diameter ({d_free}) long along {} \
+                         expected, got {l}",
+                        axis[k]
+                    ),
+                ));
+            }
+        }
+        let generated = self.run.init.is_none();
         match &self.scene {
             Scene::BumpyShear {
                 free,
@@ -413,44 +509,333 @@ impl Case {
                 wall_per_row,
                 bottom_z,
                 top_z,
-                ..
+                bottom_vx,
+                top_vx,
             } => {
                 if *free == 0 {
-                    return Err(err("scene", "free", "must be > 0, got 0".into()));
+                    return Err(at.error("scene.free", "must be > 0, got 0".into()));
                 }
                 if *wall_rows == 0 || *wall_per_row == 0 {
-                    return Err(err(
-                        "scene",
-                        "wall_rows",
+                    return Err(at.error(
+                        "scene.wall_rows",
                         "walls need rows and spheres per row".into(),
                     ));
                 }
-                if top_z <= bottom_z || top_z.is_nan() {
-                    return Err(err(
-                        "scene",
-                        "top_z",
-                        format!("must exceed bottom_z, got {top_z} <= {bottom_z}"),
+                // rows along y at √3/2 d, spheres along x at d (scene::bumpy_wall): a wall
+                // wider than the box overlaps itself across the periodic seam or leaves it
+                let extent = [
+                    ("wall_per_row", *wall_per_row as f64 * d),
+                    ("wall_rows", *wall_rows as f64 * 3f64.sqrt() / 2.0 * d),
+                ];
+                for (k, (key, width)) in extent.into_iter().enumerate() {
+                    let l = hi[k] - lo[k];
+                    if width > l * (1.0 + 1e-9) {
+                        return Err(at.error(
+                            &format!("scene.{key}"),
+                            format!(
+                                "walls within the box: a width along {} of at most {l} \
+                                 expected, got {width}",
+                                axis[k]
+                            ),
+                        ));
+                    }
+                }
+                // the free spheres need a gap of one diameter between the two walls' spheres
+                if top_z - bottom_z < 2.0 * d {
+                    return Err(at.error(
+                        "scene.top_z",
+                        format!(
+                            "the walls' spheres must leave a free sphere's diameter between \
+                             them: top_z >= bottom_z + 2 diameters = {} expected, got {top_z}",
+                            bottom_z + 2.0 * d
+                        ),
                     ));
+                }
+                for (key, z) in [("bottom_z", bottom_z), ("top_z", top_z)] {
+                    if !periodic[2] && (*z < lo[2] || *z > hi[2]) {
+                        return Err(at.error(
+                            &format!("scene.{key}"),
+                            format!(
+                                "a wall inside the box, {} <= {key} <= {} expected, got {z}",
+                                lo[2], hi[2]
+                            ),
+                        ));
+                    }
+                }
+                for (key, vx) in [("bottom_vx", bottom_vx), ("top_vx", top_vx)] {
+                    if *vx != 0.0 && !periodic[0] {
+                        return Err(at.error(
+                            &format!("scene.{key}"),
+                            format!(
+                                "the walls move along x, which must then be periodic: 0 \
+                                 expected with domain.periodic = {periodic:?}, got {vx}"
+                            ),
+                        ));
+                    }
+                }
+                if generated {
+                    let n_wall = 2 * wall_rows * wall_per_row;
+                    let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+                    // the walls' spheres reach half into the space between their centres
+                    let room = area * (top_z - bottom_z) - n_wall as f64 * sphere_volume(d) / 2.0;
+                    self.check_fill(
+                        at,
+                        "scene.free",
+                        *free,
+                        room,
+                        (bottom_z + 0.5 * d, top_z - 0.5 * d),
+                    )?;
                 }
             }
             Scene::Gas { count, speed } => {
                 if *count == 0 {
-                    return Err(err("scene", "count", "must be > 0, got 0".into()));
+                    return Err(at.error("scene.count", "must be > 0, got 0".into()));
                 }
-                non_negative("scene", "speed", *speed)?;
+                if *speed < 0.0 {
+                    return Err(at.error("scene.speed", format!("must be >= 0, got {speed}")));
+                }
+                let room = (0..3).map(|k| hi[k] - lo[k]).product::<f64>();
+                self.check_fill(
+                    at,
+                    "scene.count",
+                    *count,
+                    room,
+                    (lo[2] + 0.5 * d, hi[2] - 0.5 * d),
+                )?;
             }
             Scene::Spheres { sphere } => {
                 if sphere.is_empty() {
-                    return Err(err("scene", "sphere", "needs at least one sphere".into()));
+                    return Err(at.error("scene.sphere", "needs at least one sphere".into()));
                 }
-                for s in sphere {
+                let end = self.run.steps as f64 * self.dt();
+                for (n, s) in sphere.iter().enumerate() {
+                    let field = |key: &str| format!("scene.sphere[{n}].{key}");
                     if let Some(r) = s.radius {
-                        positive("scene", "radius", r)?;
+                        if r <= 0.0 {
+                            return Err(at.error(&field("radius"), format!("must be > 0, got {r}")));
+                        }
+                    }
+                    for k in (0..3).filter(|&k| !periodic[k]) {
+                        let (x, v) = (s.x[k], s.v[k]);
+                        if !s.fixed && (x < lo[k] || x > hi[k]) {
+                            return Err(at.error(
+                                &field("x"),
+                                format!(
+                                    "a free sphere's centre inside the box, {} <= {} <= {} \
+                                     expected, got {x}",
+                                    lo[k], axis[k], hi[k]
+                                ),
+                            ));
+                        }
+                        // a fixed sphere moves with its velocity for the whole run
+                        let to = x + v * end;
+                        if s.fixed && ((v > 0.0 && to > hi[k]) || (v < 0.0 && to < lo[k])) {
+                            return Err(at.error(
+                                &field("v"),
+                                format!(
+                                    "a wall sphere that stays in the box along the non-periodic \
+                                     {} axis for the run's {} steps (t = {end}) expected, got \
+                                     v = {v}, which takes its centre from {x} to {to}",
+                                    axis[k], self.run.steps
+                                ),
+                            ));
+                        }
                     }
                 }
             }
         }
         Ok(())
+    }
+
+    /// Refuses `n` spheres of the material's diameter in a generated scene whose spheres have
+    /// the volume `room` and centres in `z_range`: more than the densest packing of equal
+    /// spheres holds (π/(3√2) of the volume), or more than the random fill's lattice has sites
+    /// (`scene::random_fill`: simple cubic, spacing 1.0001 d, at least two layers).
+    fn check_fill(
+        &self,
+        at: &Locator<'_>,
+        field: &str,
+        n: usize,
+        room: f64,
+        z_range: (f64, f64),
+    ) -> Result<(), CaseError> {
+        let d = self.material.diameter;
+        // Kepler's bound, the fraction of space the densest packing of equal spheres fills
+        let densest = std::f64::consts::PI / (3.0 * 2f64.sqrt());
+        let fraction = n as f64 * sphere_volume(d) / room;
+        if fraction > densest {
+            return Err(at.error(
+                field,
+                format!(
+                    "at most {} spheres fit (volume fraction {densest:.4}, the densest packing), \
+                     got {n} (volume fraction {fraction:.4})",
+                    (densest * room / sphere_volume(d)).floor()
+                ),
+            ));
+        }
+        // as scene::random_fill lays out its lattice
+        let spacing = d * 1.0001;
+        let (lo, hi) = (self.domain.lo, self.domain.hi);
+        let per_layer = [0, 1].map(|k| ((hi[k] - lo[k]) / spacing).floor() as usize);
+        let height = (z_range.1 - z_range.0) - spacing;
+        let layers = (height / spacing).floor().max(-1.0) as i64 + 1;
+        if layers < 2 {
+            return Err(at.error(
+                field,
+                format!(
+                    "the random fill needs two layers of spheres: a height of {} for the \
+                     centres expected, got {}",
+                    2.0 * spacing,
+                    z_range.1 - z_range.0
+                ),
+            ));
+        }
+        let sites = per_layer[0] * per_layer[1] * layers as usize;
+        if n > sites {
+            return Err(at.error(
+                field,
+                format!(
+                    "at most {sites} spheres for the random fill's lattice ({} × {} × {layers}, \
+                     spacing 1.0001 diameters), got {n}",
+                    per_layer[0], per_layer[1]
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Refuses a time step beyond the stability limit of the stiffest contact the scene can
+    /// have; warns about a coarse one (tc/dt below [`COARSE_STEPS_PER_COLLISION`]).
+    fn validate_time_step(&self, at: &Locator<'_>) -> Result<Vec<String>, CaseError> {
+        let field = if self.run.dt.is_some() {
+            "run.dt"
+        } else {
+            "run.steps_per_collision"
+        };
+        let (dt, tc) = (self.dt(), self.tc_free_free().expect("checked before"));
+        let Some(limit) = self.stability_limit() else {
+            return Ok(Vec::new());
+        };
+        if dt > limit.dt {
+            return Err(at.error(
+                field,
+                format!(
+                    "at most the stability limit of the {} contact, dt = {:.5e} (tc/dt = {:.4}; \
+                     docs/stability.md) expected, got dt = {dt:.5e} (tc/dt = {:.4})",
+                    limit.contact(),
+                    limit.dt,
+                    tc / limit.dt,
+                    tc / dt
+                ),
+            ));
+        }
+        let per_tc = tc / dt;
+        if per_tc >= COARSE_STEPS_PER_COLLISION * (1.0 - 1e-12) {
+            return Ok(Vec::new());
+        }
+        let errors: Vec<String> = self
+            .pairs()
+            .into_iter()
+            .map(|(pair, _)| {
+                format!(
+                    "{:.1e} {}",
+                    stability::restitution_error(pair, per_tc),
+                    pair.name()
+                )
+            })
+            .collect();
+        let warning = at.error(
+            field,
+            format!(
+                "coarse time step, tc/dt = {per_tc:.3} (below {COARSE_STEPS_PER_COLLISION}): \
+                 expected relative restitution error {} (first order in dt, from the errors \
+                 measured at tc/50; docs/stability.md)",
+                errors.join(", ")
+            ),
+        );
+        Ok(vec![warning.to_string()])
+    }
+
+    /// The contacts the scene can have, each with its normal effective mass (mass): free–free
+    /// with two or more free spheres (the two lightest), free–wall with wall spheres (the
+    /// lightest free sphere). The material's diameter stands for the spheres of an initial
+    /// file.
+    pub fn pairs(&self) -> Vec<(Pair, f64)> {
+        let m = self.particle_mass();
+        let (free, walls) = match &self.scene {
+            Scene::BumpyShear { free, .. } => (vec![m; (*free).min(2)], true),
+            Scene::Gas { count, .. } => (vec![m; (*count).min(2)], false),
+            Scene::Spheres { sphere } => {
+                let density = self.material.density;
+                let d = self.material.diameter;
+                let mut free: Vec<f64> = sphere
+                    .iter()
+                    .filter(|s| !s.fixed)
+                    .map(|s| sphere_volume(2.0 * s.radius.unwrap_or(0.5 * d)) * density)
+                    .collect();
+                free.sort_by(f64::total_cmp);
+                (free, sphere.iter().any(|s| s.fixed))
+            }
+        };
+        let mut pairs = Vec::new();
+        if let [m1, m2, ..] = free[..] {
+            pairs.push((Pair::FreeFree, m1 * m2 / (m1 + m2)));
+        }
+        if let (true, Some(&m)) = (walls, free.first()) {
+            pairs.push((Pair::FreeWall, m));
+        }
+        pairs
+    }
+
+    /// The stability limit of every contact the scene can have ([`Case::pairs`]): normal, and
+    /// tangential when mu > 0.
+    pub fn stability_limits(&self) -> Vec<Limit> {
+        let c = &self.contact;
+        let normal = Spring {
+            k: c.kn,
+            gamma: c.gamman,
+        };
+        let tangential = Spring {
+            k: c.kt,
+            gamma: c.gammat,
+        };
+        let mut limits = Vec::new();
+        for (pair, meff) in self.pairs() {
+            limits.push(Limit::of(pair, Direction::Normal, meff, normal));
+            if c.mu > 0.0 {
+                limits.push(Limit::of(pair, Direction::Tangential, meff, tangential));
+            }
+        }
+        limits
+    }
+
+    /// The smallest of [`Case::stability_limits`], `None` when the scene has no contact; of
+    /// limits equal to round-off (kt/kn = γt/γn = 2/7 makes the tangential one the normal
+    /// one), the first: normal before tangential, free–free before free–wall.
+    pub fn stability_limit(&self) -> Option<Limit> {
+        self.stability_limits().into_iter().reduce(|best, l| {
+            if l.dt < best.dt * (1.0 - 1e-12) {
+                l
+            } else {
+                best
+            }
+        })
+    }
+
+    /// The largest diameters (length) of a free sphere and of any sphere.
+    fn largest_diameters(&self) -> (f64, f64) {
+        let d = self.material.diameter;
+        match &self.scene {
+            Scene::Spheres { sphere } => {
+                let diameter = |s: &SphereSpec| s.radius.map_or(d, |r| 2.0 * r);
+                let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0, f64::max);
+                (
+                    max(&mut sphere.iter().filter(|s| !s.fixed).map(diameter)),
+                    max(&mut sphere.iter().map(diameter)),
+                )
+            }
+            _ => (d, d),
+        }
     }
 
     /// Mass of one sphere, 4/3 π r³ ρ.
@@ -504,29 +889,197 @@ impl Case {
     }
 }
 
-/// Line (1-based) where `key` is set inside `[table]` (top level for ""), or the table header's
-/// line, or 0 when neither is found.
-fn locate(text: &str, table: &str, key: &str) -> usize {
-    let mut current = String::new();
-    let mut header = 0;
+/// Volume of a sphere of diameter `d`, π d³/6.
+fn sphere_volume(d: f64) -> f64 {
+    std::f64::consts::PI / 6.0 * d * d * d
+}
+
+/// Where errors about a case text point: its file, and the line of a field.
+struct Locator<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Locator<'_> {
+    /// The error `msg` about `field`, a dotted path with indices (`scene.sphere[1].x`), at the
+    /// line that sets it.
+    fn error(&self, field: &str, msg: String) -> CaseError {
+        CaseError {
+            file: self.file.into(),
+            line: locate_path(self.text, &segments(field)),
+            field: field.into(),
+            msg,
+        }
+    }
+}
+
+/// One step of a path into a TOML document.
+#[derive(Clone, Debug, PartialEq)]
+enum Seg {
+    Key(String),
+    Index(usize),
+}
+
+/// The steps of a dotted path with indices: `scene.sphere[1].x` → scene, sphere, 1, x.
+fn segments(field: &str) -> Vec<Seg> {
+    let mut out = Vec::new();
+    for part in field.split('.') {
+        let mut pieces = part.split('[');
+        out.push(Seg::Key(pieces.next().unwrap_or("").to_string()));
+        for p in pieces {
+            if let Ok(n) = p.trim_end_matches(']').parse() {
+                out.push(Seg::Index(n));
+            }
+        }
+    }
+    out
+}
+
+/// The first number in `v` that is not finite (NaN or ±inf), with its dotted path.
+fn non_finite(v: &toml::Value, path: &str) -> Option<(String, f64)> {
+    match v {
+        toml::Value::Float(x) if !x.is_finite() => Some((path.to_string(), *x)),
+        toml::Value::Table(t) => t.iter().find_map(|(k, v)| {
+            let p = if path.is_empty() {
+                k.clone()
+            } else {
+                format!("{path}.{k}")
+            };
+            non_finite(v, &p)
+        }),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(n, v)| non_finite(v, &format!("{path}[{n}]"))),
+        _ => None,
+    }
+}
+
+/// Line (1-based) of the key line that sets `path` (or a value it is inside of, as `x` holds
+/// `x[1]`), else of the header of the deepest table holding it, else 0. A `[[name]]` header
+/// opens element n of the array `name`, counted from 0.
+fn locate_path(text: &str, path: &[Seg]) -> usize {
+    let mut table: Vec<Seg> = Vec::new();
+    let mut count: std::collections::HashMap<String, usize> = Default::default();
+    let (mut header, mut header_depth) = (0, 0);
     for (n, line) in text.lines().enumerate() {
         let l = line.trim();
         if let Some(name) = table_header(l) {
-            current = name;
-            if current == table {
-                header = n + 1;
+            table = name
+                .split('.')
+                .map(|k| Seg::Key(k.trim().trim_matches('"').to_string()))
+                .collect();
+            if l.starts_with("[[") {
+                let c = count.entry(name).or_insert(0);
+                table.push(Seg::Index(*c));
+                *c += 1;
+            }
+            if path.starts_with(&table) && table.len() > header_depth {
+                (header, header_depth) = (n + 1, table.len());
             }
             continue;
         }
-        if current == table {
-            if let Some((k, _)) = l.split_once('=') {
-                if k.trim() == key {
-                    return n + 1;
-                }
+        if l.starts_with('#') {
+            continue;
+        }
+        if let Some((k, _)) = l.split_once('=') {
+            let mut full = table.clone();
+            full.extend(
+                k.split('.')
+                    .map(|k| Seg::Key(k.trim().trim_matches('"').to_string())),
+            );
+            if path.starts_with(&full) {
+                return n + 1;
             }
         }
     }
     header
+}
+
+/// The first key line inside `[table]` or the tables under it (`[[table.sub]]`) for which
+/// `pick(key, value text)` holds: its line (1-based) and its dotted field with indices.
+fn find_under(
+    text: &str,
+    table: &str,
+    pick: impl Fn(&str, &str) -> bool,
+) -> Option<(usize, String)> {
+    let mut current: Vec<Seg> = Vec::new();
+    let mut count: std::collections::HashMap<String, usize> = Default::default();
+    let top = segments(table);
+    for (n, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if let Some(name) = table_header(l) {
+            current = segments(&name);
+            if l.starts_with("[[") {
+                let c = count.entry(name).or_insert(0);
+                current.push(Seg::Index(*c));
+                *c += 1;
+            }
+            continue;
+        }
+        let Some((k, v)) = l.split_once('=') else {
+            continue;
+        };
+        let value = v.split(" #").next().unwrap_or("").trim();
+        if l.starts_with('#') || !current.starts_with(&top) || !pick(k.trim(), value) {
+            continue;
+        }
+        let mut field = String::new();
+        for seg in &current {
+            match seg {
+                Seg::Key(k) if field.is_empty() => field.push_str(k),
+                Seg::Key(k) => field.push_str(&format!(".{k}")),
+                Seg::Index(i) => field.push_str(&format!("[{i}]")),
+            }
+        }
+        return Some((n + 1, format!("{field}.{}", k.trim())));
+    }
+    None
+}
+
+/// The first element `table.name[i]` of an array of tables under `table` (a table's dotted
+/// name) that lacks `key`, when `table` itself has it or is not a table.
+fn lacking(text: &str, table: &str, key: &str) -> Option<String> {
+    let doc: toml::Value = toml::from_str(text).ok()?;
+    let mut t = &doc;
+    for k in table.split('.') {
+        t = t.get(k)?;
+    }
+    let t = t.as_table()?;
+    t.iter().find_map(|(name, v)| {
+        let elements = v.as_array()?;
+        let i = elements
+            .iter()
+            .position(|e| e.as_table().is_some_and(|e| !e.contains_key(key)))?;
+        Some(format!("{table}.{name}[{i}]"))
+    })
+}
+
+/// The length of the array a key line's value text holds, if it is one.
+fn array_of(text: &str) -> Option<usize> {
+    let v: toml::Value = toml::from_str(&format!("v = {text}")).ok()?;
+    v.get("v")?.as_array().map(Vec::len)
+}
+
+/// The value a serde "invalid type/value" message quotes: `2.5` of "invalid type: floating
+/// point `2.5`, expected usize", or "one" (with its quotes) of a string.
+fn offending_value(msg: &str) -> Option<&str> {
+    let rest = msg
+        .strip_prefix("invalid type: ")
+        .or_else(|| msg.strip_prefix("invalid value: "))?;
+    let rest = rest.split(", expected").next()?;
+    if let Some(start) = rest.find('`') {
+        return rest[start + 1..].split('`').next();
+    }
+    let start = rest.find('"')?;
+    Some(&rest[start..])
+}
+
+/// Whether the value text of a key line is the value `quoted` from an error message (numbers
+/// compared as numbers: `2_000` is `2000`).
+fn same_value(text: &str, quoted: &str) -> bool {
+    let number = |s: &str| s.replace('_', "").parse::<f64>().ok();
+    text == quoted || matches!((number(text), number(quoted)), (Some(a), Some(b)) if a == b)
 }
 
 /// The table a header line `[name]` or `[[name]]` opens.
@@ -637,5 +1190,46 @@ mod tests {
         );
         let e = Case::parse(&bad, "bad.toml").unwrap_err();
         assert_eq!(e.field, "run.dt");
+    }
+
+    const PAIR: &str = include_str!("../cases/verify/binary_collision.toml");
+    const WALL: &str = include_str!("../cases/verify/oblique_impact.toml");
+
+    /// The line of the second `[[scene.sphere]]`'s `x`, and of a key of a plain table.
+    #[test]
+    fn a_field_is_located_in_its_table_and_array_element() {
+        let second_x = PAIR
+            .lines()
+            .position(|l| l.starts_with("x = [0.5005"))
+            .unwrap()
+            + 1;
+        let path = segments("scene.sphere[1].x[2]");
+        assert_eq!(locate_path(PAIR, &path), second_x);
+        let kn = PAIR.lines().position(|l| l.starts_with("kn =")).unwrap() + 1;
+        assert_eq!(locate_path(PAIR, &segments("contact.kn")), kn);
+        // absent key: the header of the deepest table that would hold it
+        let header = PAIR.lines().position(|l| l == "[contact]").unwrap() + 1;
+        assert_eq!(locate_path(PAIR, &segments("contact.bogus")), header);
+    }
+
+    /// Two free spheres have a free–free contact only; a free sphere and a wall sphere a
+    /// free–wall one; with kt/kn = γt/γn = 2/7 the normal limit is named.
+    #[test]
+    fn the_contacts_of_the_scene_set_the_limit() {
+        let pair = Case::parse(PAIR, "p.toml").unwrap();
+        let m = pair.particle_mass();
+        assert_eq!(pair.pairs(), vec![(Pair::FreeFree, 0.5 * m)]);
+        assert_eq!(pair.stability_limits().len(), 2);
+        let limit = pair.stability_limit().unwrap();
+        assert_eq!(
+            (limit.pair, limit.direction),
+            (Pair::FreeFree, Direction::Normal)
+        );
+        let wall = Case::parse(WALL, "w.toml").unwrap();
+        assert_eq!(wall.pairs(), vec![(Pair::FreeWall, m)]);
+        assert!(wall.stability_limit().unwrap().dt > limit.dt);
+        let quick = Case::parse(CASE, "q.toml").unwrap();
+        let kinds: Vec<Pair> = quick.pairs().iter().map(|p| p.0).collect();
+        assert_eq!(kinds, [Pair::FreeFree, Pair::FreeWall]);
     }
 }

@@ -16,6 +16,7 @@ pub mod neighbor;
 pub mod peers;
 pub mod run;
 pub mod scene;
+pub mod stability;
 pub mod state;
 pub mod step;
 pub mod team;

@@ -47,6 +47,9 @@ enum Command {
     /// x,y,z, qw,qx,qy,qz, vx,vy,vz, wx,wy,wz of sphere 1 and of sphere 2) and write the forces
     /// and torques on each sphere at every row (FORCES.csv).
     Kinematics(cli::kinematics::Args),
+    /// The stability map: dt, stiffness, speed, damping, friction and packing at their
+    /// extremes, each row with theory, measurement, what verdem did and a verdict.
+    Extremes(cli::extremes::Args),
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash(cli::hash::Args),
     /// Convert a MercuryCG series (verdem's or a peer's) into ParaView files: NAME.NNNN.vtu per
@@ -67,6 +70,7 @@ fn main() {
         Command::Kinematics(a) => cli::kinematics::exec(a),
         Command::Hash(a) => cli::hash::exec(a),
         Command::Vtk(a) => cli::vtk::exec(a),
+        Command::Extremes(a) => cli::extremes::exec(a),
     };
     match outcome {
         Ok(Finished::Done) => {}

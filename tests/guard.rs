@@ -95,12 +95,22 @@ fn coincident_spheres_are_stopped_before_anything_is_written() {
     no_garbage(&out);
 }
 
-/// dt = 2 tc: the scheme is unstable; the spheres used to fly through each other and out of
-/// the box with the energy growing 65-fold, exit status 0.
+/// dt = tc/1.3: within the stability limit of one free–wall contact (tc/1.137), which the case
+/// validation checks, but beyond that of a free sphere squeezed between two wall spheres (two
+/// springs at once: √2 times the frequency; the spectral radius of its step is 3.8). Unstable
+/// runs used to end with exit status 0.
 #[test]
-fn a_time_step_beyond_the_collision_time_is_stopped_with_its_step_and_particles() {
+fn an_unstable_time_step_is_stopped_with_its_step_and_particles() {
     let dir = tempfile::tempdir().unwrap();
-    let case = two_spheres(dir.path(), [-1.0, 1.0], [5.0, -5.0], 0.5, 2000, 10);
+    let pair = two_spheres(dir.path(), [0.0, -0.98], [-0.1, 0.0], 1.3, 2000, 10);
+    let text = std::fs::read_to_string(&pair).unwrap().replace(
+        "x = [-0.98, 0.0, 0.0]\nv = [0, 0.0, 0.0]\n",
+        "x = [-0.98, 0.0, 0.0]\nfixed = true\n[[scene.sphere]]\nx = [0.98, 0.0, 0.0]\nfixed = true\n",
+    );
+    assert!(text.contains("fixed"), "{text}");
+    let case = dir.path().join("squeeze.toml");
+    std::fs::write(&case, text).unwrap();
+    let case = case.display().to_string();
     let out = dir.path().join("out");
     let (code, err) = run(&case, &out);
     assert_eq!(code, Some(3), "{err}");

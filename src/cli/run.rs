@@ -54,6 +54,9 @@ pub struct Args {
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let (case, mut engine) = a.common.load()?;
+    for warning in case.warnings() {
+        eprintln!("warning: {warning}");
+    }
     print_contact_summary(&case);
     let tag = checkpoint::tag(&case);
     if let Some(ck) = &a.resume {

@@ -11,6 +11,7 @@
 
 pub mod collision;
 pub mod conservation;
+pub mod extremes;
 pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
