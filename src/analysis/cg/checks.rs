@@ -6,6 +6,30 @@ use super::{columns, core_range, Profiles, COLUMNS};
 use crate::analysis::stats::{block, standard_error, trend, weighted_mean_chi2};
 use crate::analysis::{Limit, Verdict};
 
+/// A number in a report: as formatted when finite, else "undefined" (one block gives no error
+/// bar, an empty core no mean): no NaN or infinity is written.
+struct Shown(f64);
+
+impl std::fmt::Display for Shown {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_finite() {
+            std::fmt::Display::fmt(&self.0, f)
+        } else {
+            f.write_str("undefined")
+        }
+    }
+}
+
+impl std::fmt::LowerExp for Shown {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_finite() {
+            std::fmt::LowerExp::fmt(&self.0, f)
+        } else {
+            f.write_str("undefined")
+        }
+    }
+}
+
 /// One check: its name is the verdict's quantity; the report prints the measurement and the
 /// expectation in words.
 pub type Check = Verdict;
@@ -69,7 +93,11 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         )
         .judged_if(judged)
         .described(
-            format!("chi2/dof = {tau_chi:.2} (mean {tau_mean:.5})"),
+            format!(
+                "chi2/dof = {:.2} (mean {:.5})",
+                Shown(tau_chi),
+                Shown(tau_mean)
+            ),
             format!("< {limit}{unjudged}"),
         ),
     );
@@ -91,7 +119,11 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         )
         .judged_if(judged)
         .described(
-            format!("chi2/dof = {zz_chi:.2} (mean {zz_mean:.5})"),
+            format!(
+                "chi2/dof = {:.2} (mean {:.5})",
+                Shown(zz_chi),
+                Shown(zz_mean)
+            ),
             format!("< {limit}{unjudged}"),
         ),
     );
@@ -144,8 +176,8 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
                 )
                 .judged_if(judged)
                 .described(
-                    format!("{gap:.5} vs {wall:.5}"),
-                    format!("difference < 3 combined SE ({tol:.2e}){unjudged}"),
+                    format!("{:.5} vs {:.5}", Shown(gap), Shown(wall)),
+                    format!("difference < 3 combined SE ({:.2e}){unjudged}", Shown(tol)),
                 ),
             );
         }
@@ -171,7 +203,8 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         )
         .described(
             format!(
-                "max relative error {worst:.2e} over {} saves",
+                "max relative error {:.2e} over {} saves",
+                Shown(worst),
                 p.per_save.len()
             ),
             format!("< {tol:e}"),
@@ -207,7 +240,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             Verdict::judge("", &quantity, chi, Limit::Below(limit))
                 .judged_if(judged)
                 .described(
-                    format!("chi2/dof = {chi:.2}"),
+                    format!("chi2/dof = {:.2}", Shown(chi)),
                     format!("< {limit}{unjudged}"),
                 ),
         );
@@ -268,7 +301,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             },
         )
         .described(
-            format!("{mean_ratio:.3}"),
+            format!("{:.3}", Shown(mean_ratio)),
             "about 1 (within ~20%; reported only)".into(),
         ),
     );
@@ -321,7 +354,19 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{unsteady_note, Limit, Verdict, STEADY};
+    use super::{unsteady_note, Limit, Shown, Verdict, STEADY};
+
+    #[test]
+    fn a_number_that_is_not_finite_is_written_as_a_word() {
+        assert_eq!(format!("{:.2}", Shown(1.234)), "1.23");
+        assert_eq!(format!("{:.2e}", Shown(1234.0)), "1.23e3");
+        for x in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert_eq!(
+                format!("{:.2} {:.2e}", Shown(x), Shown(x)),
+                "undefined undefined"
+            );
+        }
+    }
 
     #[test]
     fn only_a_failed_steadiness_check_adds_the_note() {
