@@ -733,13 +733,17 @@ impl Case {
         if per_tc >= COARSE_STEPS_PER_COLLISION * (1.0 - 1e-12) {
             return Ok(Vec::new());
         }
+        let normal = stability::Spring {
+            k: self.contact.kn,
+            gamma: self.contact.gamman,
+        };
         let errors: Vec<String> = self
             .pairs()
             .into_iter()
-            .map(|(pair, _)| {
+            .map(|(pair, meff)| {
                 format!(
                     "{:.1e} {}",
-                    stability::restitution_error(pair, per_tc),
+                    stability::restitution_error(meff, normal, dt),
                     pair.name()
                 )
             })
@@ -748,8 +752,8 @@ impl Case {
             field,
             format!(
                 "coarse time step, tc/dt = {per_tc:.3} (below {COARSE_STEPS_PER_COLLISION}): \
-                 expected relative restitution error {} (first order in dt, from the errors \
-                 measured at tc/50; docs/stability.md)",
+                 relative restitution error up to {} (verdem's scheme run on one head-on \
+                 collision, worst onset within a step; docs/stability.md)",
                 errors.join(", ")
             ),
         );

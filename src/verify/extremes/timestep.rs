@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{g3, load, parse, set, stopped, unset, Did, Inputs, MapRow};
 use crate::case::{Case, Scene as SceneSpec, SphereSpec};
-use crate::stability::{critical_dt, restitution_error, Pair, Spring};
+use crate::stability::{critical_dt, restitution_error, Spring};
 use crate::step::guard::Failure;
 use crate::verify::collision::{closed_form, collide_with_phase};
 
@@ -121,11 +121,7 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
     let meff = if wall { m } else { 0.5 * m };
     let cf = closed_form(&base, meff);
     let limit = limit_per_tc(&base, meff);
-    let (name, pair) = if wall {
-        (FREE_WALL, Pair::FreeWall)
-    } else {
-        (FREE_FREE, Pair::FreeFree)
-    };
+    let name = if wall { FREE_WALL } else { FREE_FREE };
     let text = collision_text(&base_text, wall);
     let mut rows = Vec::new();
     for per_tc in PER_TC {
@@ -165,7 +161,14 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
                 cf.e,
                 g3(cf.delta_max_per_speed),
                 if stable { "stable" } else { "unstable" },
-                g3(restitution_error(pair, per_tc))
+                g3(restitution_error(
+                    meff,
+                    Spring {
+                        k: base.contact.kn,
+                        gamma: base.contact.gamman
+                    },
+                    base.tc_free_free().unwrap_or(f64::NAN) / per_tc
+                ))
             ),
             measured: text,
             pass: judge(stable, trustworthy, &did),
