@@ -455,12 +455,13 @@ impl Case {
         if c.mu > 0.0 {
             positive("contact", "kt", c.kt)?;
         }
-        if self.tc_free_free().is_none() {
+        if self.tc_free_free().is_none() && self.run.steps_per_collision.is_some() {
             return Err(err(
-                "contact",
-                "gamman",
+                "run",
+                "steps_per_collision",
                 format!(
-                    "overdamped: gamman = {} leaves no oscillation (kn/meff < (gamman/2meff)^2)",
+                    "a collision time to divide expected, but gamman = {} over-damps the free–free \
+                     contact (kn/meff < (gamman/2meff)^2: it never rebounds); give run.dt instead",
                     c.gamman
                 ),
             ));
@@ -712,9 +713,34 @@ impl Case {
         } else {
             "run.steps_per_collision"
         };
-        let (dt, tc) = (self.dt(), self.tc_free_free().expect("checked before"));
+        let dt = self.dt();
         let Some(limit) = self.stability_limit() else {
             return Ok(Vec::new());
+        };
+        // An over-damped contact has no collision time: the limit is stated as a dt only.
+        let Some(tc) = self.tc_free_free() else {
+            if dt > limit.dt {
+                return Err(at.error(
+                    field,
+                    format!(
+                        "at most the stability limit of the {} contact, dt = {:.5e} \
+                         (docs/stability.md) expected, got dt = {dt:.5e}",
+                        limit.contact(),
+                        limit.dt,
+                    ),
+                ));
+            }
+            return Ok(vec![at
+                .error(
+                    "contact.gamman",
+                    format!(
+                        "over-damped contact: gamman = {} leaves no oscillation, so colliding \
+                         spheres do not rebound (with clip_normal = false the dashpot also pulls \
+                         them together as they part)",
+                        self.contact.gamman
+                    ),
+                )
+                .to_string()]);
         };
         if dt > limit.dt {
             return Err(at.error(

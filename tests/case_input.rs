@@ -15,7 +15,7 @@ fn run(case: &Path) -> (Option<i32>, String, String) {
         .current_dir(common::root())
         .arg("run")
         .arg(case)
-        .args(["--steps", "0", "--quiet", "--out"])
+        .args(["--steps", "0", "--quiet", "--force", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -340,12 +340,12 @@ fn non_physical_values() {
             "must be > 0",
         ),
         bad(
-            QUICK,
+            PAIR,
             "gamman = ",
             "gamman = 1e3",
-            "gamman",
-            "contact.gamman",
-            "overdamped",
+            "steps_per_collision",
+            "run.steps_per_collision",
+            "over-damps the free–free contact",
         ),
     ]);
 }
@@ -569,6 +569,24 @@ fn a_time_step_beyond_the_stability_limit_is_refused_with_the_limit() {
     ]);
 }
 
+/// An over-damped contact (no collision time) with an explicit dt within its stability limit
+/// runs, with a warning that its spheres do not rebound; beyond the limit it is refused.
+#[test]
+fn an_over_damped_contact_runs_with_an_explicit_time_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, text) = edited(dir.path(), PAIR, "gamman = ", "gamman = 1e3");
+    let text = text.replace("steps_per_collision = 50.0", "dt = 1e-5");
+    std::fs::write(&path, &text).unwrap();
+    let (code, _, err) = run(&path);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("contact.gamman: over-damped contact"), "{err}");
+    // 4/(c + √(c² + 4ω²)) with c = γ/meff, ω² = kn/meff: 5.0e-4 for meff = m/2
+    std::fs::write(&path, text.replace("dt = 1e-5", "dt = 1e-3")).unwrap();
+    let (code, _, err) = run(&path);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("run.dt: at most the stability limit"), "{err}");
+}
+
 /// A time step within the pair limit but coarse (tc/dt below 10) runs, with a warning on stderr
 /// naming the expected restitution error; at tc/10 and finer nothing is said.
 #[test]
@@ -593,8 +611,22 @@ fn a_coarse_time_step_runs_with_a_warning() {
         path.display()
     );
     assert!(err.contains(&head), "{err}");
-    // 8.8e-4·50/1.3, the free–wall estimate only (no free–free contact in this scene)
-    assert!(err.contains("3.4e-2 free–wall"), "{err}");
+    // the error of the scheme on one collision, for the free–wall contact only (no free–free
+    // contact in this scene)
+    let named = |case_path: &std::path::Path, meff_of: fn(f64) -> f64| {
+        let case = verdem::case::Case::load(case_path).unwrap();
+        let spring = verdem::stability::Spring {
+            k: case.contact.kn,
+            gamma: case.contact.gamman,
+        };
+        let meff = meff_of(case.particle_mass());
+        format!(
+            "{:.1e}",
+            verdem::stability::restitution_error(meff, spring, case.dt())
+        )
+    };
+    let wall_error = named(&path, |m| m);
+    assert!(err.contains(&format!("{wall_error} free–wall")), "{err}");
     assert!(!err.contains("free–free"), "{err}");
 
     let (path, _) = edited(
@@ -606,8 +638,9 @@ fn a_coarse_time_step_runs_with_a_warning() {
     let (code, _, err) = run(&path);
     assert_eq!(code, Some(0), "{err}");
     assert!(err.contains("tc/dt = 8.000 (below 10)"), "{err}");
-    // 3.4e-4·50/8 and 8.8e-4·50/8 would be named only where the contacts exist: two free spheres
-    assert!(err.contains("2.1e-3 free–free"), "{err}");
+    // named only where the contacts exist: two free spheres
+    let pair_error = named(&path, |m| 0.5 * m);
+    assert!(err.contains(&format!("{pair_error} free–free")), "{err}");
     assert!(!err.contains("free–wall"), "{err}");
 
     for per_tc in ["10.0", "50.0"] {
