@@ -393,7 +393,12 @@ fn prepare_diagnostics(
         .has_headers(false)
         .from_writer(CSV_HEADER.as_bytes().to_vec());
     if resumed {
-        let old = std::fs::read_to_string(path).unwrap_or_default();
+        // A folder without the table (a resume into another folder) starts a new one; a table
+        // that cannot be read is an error, never taken for an empty one.
+        let old = match std::fs::read_to_string(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            read => read.with_context(|| format!("{}: cannot read", path.display()))?,
+        };
         let file = path.display().to_string();
         for record in csv_table::records(&file, &old, false) {
             let (line, record) = record?;

@@ -13,7 +13,7 @@ fn kratos() -> &'static dyn Peer {
 
 /// Kratos clips the normal force at zero, so its restitution is that of the clipped closed
 /// form (the force ends at Fn = 0; the unclipped one differs by 2.0e-3 free–free, beyond the
-/// tolerance), and its contact lasts the closed form's time to a step. Its scheme is verdem's
+/// tolerance), and its spheres overlap for the closed form's contact time to a step. Its scheme is verdem's
 /// (its velocity is verdem's half-step one), so it gives verdem's clipped restitution to
 /// round-off.
 #[test]
@@ -30,7 +30,7 @@ fn kratos_collisions_follow_the_clipped_closed_form_and_verdem() {
         8
     );
     assert_eq!(
-        rows.iter().filter(|r| r.quantity == "contact time").count(),
+        rows.iter().filter(|r| r.quantity == "overlap time").count(),
         8
     );
     for r in &rows {

@@ -348,6 +348,11 @@ fix             still2 top    move linear 0 0 0\n\
                 "{}: atom ids {a} {b} out of range",
                 path.display()
             );
+            ensure!(
+                a != b,
+                "{}: a contact of atom {a} with itself (two different atom ids expected)",
+                path.display()
+            );
             let (a, b) = (a - 1, b - 1);
             let on_a = D::force_on_first(&r, s, a, b);
             if on_a == Vec3::zeros() {

@@ -65,10 +65,16 @@ pub fn benchmark_curves<'a>(t: &Table, label: &'a str) -> Vec<(String, Curve<'a>
 /// Draws panels of curves (one or more codes per panel) into a PNG.
 pub fn panels_png(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> {
     register_font()?;
-    // Drawn beside the target and renamed: an interrupted run never leaves half a picture.
+    // Drawn beside the target, then written durably in its place (`io::atomic`): an
+    // interrupted run or a full disk never leaves half a picture or the scratch file.
     let tmp = path.with_extension("part.png");
-    draw(panels, &tmp)?;
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write", path.display()))
+    let drawn = draw(panels, &tmp).and_then(|()| {
+        std::fs::read(&tmp).with_context(|| format!("{}: cannot read back", tmp.display()))
+    });
+    // the scratch file goes whatever happened; a failure to remove it is not the error to report
+    let _ = std::fs::remove_file(&tmp);
+    crate::io::atomic::write(path, &drawn?)
+        .with_context(|| format!("{}: cannot write", path.display()))
 }
 
 fn draw(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> {
