@@ -162,6 +162,39 @@ fn the_overlap_limit_is_read_from_the_case_and_checked() {
     );
 }
 
+/// The command line replaces the case's limits: `--guard-overlap` tightens the overlap limit of
+/// a sound collision until it stops, `--guard-energy` loosens the energy limit until the heating
+/// gas runs; values out of range are refused by the parser.
+#[test]
+fn the_guard_limits_are_set_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = two_spheres(dir.path(), [-1.0, 1.0], [5.0, -5.0], 50.0, 2000, 500);
+    let with = |case: &str, out: &str, flags: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+            .current_dir(common::root())
+            .args(["run", case, "--quiet", "--out"])
+            .arg(dir.path().join(out))
+            .args(flags)
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = with(&case, "tight", &["--guard-overlap", "0.002"]);
+    assert_eq!(code, Some(3), "{err}");
+    assert!(err.contains("exceeds the limit 1e-3"), "{err}");
+    let (code, err) = with(&case, "wide", &["--guard-overlap", "1.5"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("must be above 0 and at most 1"), "{err}");
+    let gas = elastic_gas(dir.path(), 2.0, 2000);
+    let (code, err) = with(&gas, "gas", &["--guard-energy", "100"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = with(&gas, "gas0", &["--guard-energy", "0"]);
+    assert_eq!(code, Some(2), "{err}");
+}
+
 /// A periodic gas of 500 spheres with the benchmark's spring and no dissipation at all
 /// (γn = γt = 0, frictionless), dt = tc/`per_tc`, `steps` steps.
 fn elastic_gas(dir: &Path, per_tc: f64, steps: u64) -> String {

@@ -31,13 +31,27 @@ pub struct Common {
     /// Cell edge of the neighbour grid (length; raised to 2 r_max + skin).
     #[arg(long, allow_negative_numbers = true, value_parser = non_negative)]
     cell: Option<f64>,
+    /// The run guard's largest overlap, as a fraction of the smaller radius (0 < F ≤ 1;
+    /// replaces the case's `[guard] overlap`).
+    #[arg(long, allow_negative_numbers = true, value_parser = fraction)]
+    guard_overlap: Option<f64>,
+    /// The run guard's largest energy gain over a window beyond the walls' and gravity's work,
+    /// as a fraction of the energy at play (> 0; replaces the case's `[guard] energy`).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
+    guard_energy: Option<f64>,
 }
 
 impl Common {
     /// The case and its engine, built with the command line's overrides; warns when the team
     /// has more threads than the process may use CPUs.
     pub fn load(&self) -> anyhow::Result<(Case, Box<dyn Engine>)> {
-        let case = Case::load(&self.case)?;
+        let mut case = Case::load(&self.case)?;
+        if let Some(overlap) = self.guard_overlap {
+            case.guard.overlap = overlap;
+        }
+        if let Some(energy) = self.guard_energy {
+            case.guard.energy = energy;
+        }
         let scene = scene::build(&case, self.init.as_deref())?;
         let o = Overrides {
             threads: self.threads,
@@ -72,6 +86,16 @@ pub fn positive(s: &str) -> Result<f64, String> {
         Ok(v)
     } else {
         Err(format!("must be positive and finite, got {s}"))
+    }
+}
+
+/// A fraction above 0 and at most 1.
+pub fn fraction(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v > 0.0 && v <= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be above 0 and at most 1, got {s}"))
     }
 }
 
