@@ -48,6 +48,8 @@ pub struct RunSummary {
     pub saves: u64,
     /// The run stopped before `end_step` on request, with a checkpoint at `step`.
     pub interrupted: bool,
+    /// Largest overlap of any contact, as a fraction of the pair's smaller radius.
+    pub deepest_overlap: f64,
 }
 
 /// Steps of the full bumpy-shear benchmark (`cases/shear_flow.toml`, `docs/benchmark.md`: Nt).
@@ -292,6 +294,7 @@ pub fn run(
         stages: *engine.counters(),
         saves,
         interrupted,
+        deepest_overlap: engine.deepest_overlap(),
     })
 }
 

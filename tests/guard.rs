@@ -163,8 +163,9 @@ fn the_overlap_limit_is_read_from_the_case_and_checked() {
 }
 
 /// The command line replaces the case's limits: `--guard-overlap` tightens the overlap limit of
-/// a sound collision until it stops, `--guard-energy` loosens the energy limit until the heating
-/// gas runs; values out of range are refused by the parser.
+/// a sound collision until it stops (and, less tight, until the run is warned about),
+/// `--guard-energy` loosens the energy limit until the heating gas runs; values out of range are
+/// refused by the parser.
 #[test]
 fn the_guard_limits_are_set_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -185,6 +186,18 @@ fn the_guard_limits_are_set_from_the_command_line() {
     let (code, err) = with(&case, "tight", &["--guard-overlap", "0.002"]);
     assert_eq!(code, Some(3), "{err}");
     assert!(err.contains("exceeds the limit 1e-3"), "{err}");
+    // the overlap peaks near 1.1e-2, 2.2e-2 of the radius: beyond half of 0.03, a warning; not
+    // beyond half of 0.1
+    let (code, err) = with(&case, "warned", &["--guard-overlap", "0.03"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("warning: the largest overlap reached 2.1")
+            && err.contains("beyond 0.5 of the run guard's limit 0.03"),
+        "{err}"
+    );
+    let (code, err) = with(&case, "quiet", &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("largest overlap"), "{err}");
     let (code, err) = with(&case, "wide", &["--guard-overlap", "1.5"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("must be above 0 and at most 1"), "{err}");

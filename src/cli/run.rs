@@ -52,6 +52,9 @@ pub struct Args {
     quiet: bool,
 }
 
+/// The fraction of the guard's overlap limit beyond which a run that reached it is warned about.
+const OVERLAP_WARNING: f64 = 0.5;
+
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let (case, mut engine) = a.common.load()?;
     for warning in case.warnings() {
@@ -111,6 +114,15 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         stop: Some(stop_on_signal()?),
     };
     let s = run::run(engine.as_mut(), &opts, a.resume.is_some())?;
+    let limit = engine.params().guard.overlap;
+    if s.deepest_overlap > OVERLAP_WARNING * limit {
+        eprintln!(
+            "warning: the largest overlap reached {:.3e} of the smaller radius, beyond {} of the \
+             run guard's limit {limit}: the contacts are soft for these speeds, or the step is \
+             coarse (the guard stops a run at the limit)",
+            s.deepest_overlap, OVERLAP_WARNING
+        );
+    }
     if s.interrupted {
         let ck = run::checkpoint_path(&opts.out_dir, &opts.name);
         println!(

@@ -74,6 +74,9 @@ pub struct Core<H> {
     /// Why the run guard stopped the last run, if it did; the state is then not to be trusted
     /// and no further step is taken.
     pub failure: Option<Failure>,
+    /// Largest overlap of any contact in the pair passes so far, as a fraction of the smaller
+    /// radius of the pair.
+    pub deepest: f64,
     pub(super) work: Workspace,
 }
 
@@ -123,6 +126,7 @@ impl<H: History> Core<H> {
             },
             counters: StageTimes::default(),
             failure: None,
+            deepest: 0.0,
             work: Workspace {
                 moved_bound: [0.0; 2],
                 builder,

@@ -77,6 +77,9 @@ pub trait Engine: Send {
     fn contact_count(&self) -> usize;
     /// Number of candidate pairs at the last build.
     fn pair_count(&self) -> usize;
+    /// Largest overlap of any contact in any step run so far, as a fraction of the pair's
+    /// smaller radius (0 before the first step; the guard stops a run beyond `[guard] overlap`).
+    fn deepest_overlap(&self) -> f64;
     /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
     /// with the reason, when the run guard finds a number that cannot be trusted; after that
     /// every call fails the same way.
@@ -116,6 +119,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn pair_count(&self) -> usize {
         self.core.pair_count()
+    }
+    fn deepest_overlap(&self) -> f64 {
+        self.core.deepest
     }
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
@@ -303,7 +309,7 @@ impl<L: ContactLaw> Simulation<L> {
             skin,
         };
         let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
-        let (local, bound, done, supplied) = if threads == 1 {
+        let done = if threads == 1 {
             work_of(0)
         } else {
             std::thread::scope(|s| {
@@ -313,24 +319,27 @@ impl<L: ContactLaw> Simulation<L> {
                         s.spawn(move || work_of(tid))
                     })
                     .collect();
-                let mine = work_of(0);
-                // Integer sums: the same in any order of the threads.
-                let others: i128 = handles
-                    .into_iter()
-                    .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)).3)
-                    .sum();
-                (mine.0, mine.1, mine.2, mine.3 + others)
+                let mut mine = work_of(0);
+                for h in handles {
+                    let theirs = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+                    // an integer sum: the same in any order of the threads
+                    mine.supplied += theirs.supplied;
+                    mine.deepest = mine.deepest.max(theirs.deepest);
+                }
+                mine
             })
         };
         let breach = team.alarm.take();
         let core = &mut self.core;
-        core.counters.add_times(&local);
-        core.counters.rebuilds += local.rebuilds;
-        core.work.moved_bound = bound;
-        for _ in 0..done {
+        core.counters.add_times(&done.times);
+        core.counters.rebuilds += done.times.rebuilds;
+        core.work.moved_bound = done.bound;
+        core.deepest = core.deepest.max(done.deepest);
+        for _ in 0..done.steps {
             core.state.time += dt;
         }
-        core.state.step += done;
+        core.state.step += done.steps;
+        let supplied = done.supplied;
         if let Some((_, b)) = breach {
             let state = &mut core.state;
             core.failure = Some(b.report(state.step, state.time, &state.id));
@@ -338,6 +347,17 @@ impl<L: ContactLaw> Simulation<L> {
         }
         supplied
     }
+}
+
+/// What a thread's run leaves: its counters, the displacement bounds at the end, the steps
+/// completed (fewer than asked when the run guard stops the run: every thread stops at the same
+/// meeting), the work supplied in its passes (fixed point) and the largest overlap it saw.
+struct Done {
+    times: StageTimes,
+    bound: [f64; 2],
+    steps: u64,
+    supplied: i128,
+    deepest: f64,
 }
 
 /// What the threads of a run share.
@@ -378,6 +398,8 @@ struct Worker<'t, 'a, L: ContactLaw> {
     /// Work of the walls and of gravity along periodic axes on the free particles in this
     /// thread's passes, in fixed point (the run guard's energy balance).
     supplied: i128,
+    /// Largest overlap of its pair passes, as a fraction of the smaller radius.
+    deepest: f64,
 }
 
 impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
@@ -391,16 +413,12 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             times: StageTimes::default(),
             laps: Laps::new(tid == 0),
             supplied: 0,
+            deepest: 0.0,
         }
     }
 
-    /// The step loop of this thread, as named stages; returns its counters, the displacement
-    /// bounds at the end, the steps completed (fewer than `steps` when the run guard stops
-    /// the run: every thread stops at the same meeting) and the work supplied in its passes.
-    fn run<const ROT: bool, const GRAV: bool>(
-        mut self,
-        steps: u64,
-    ) -> (StageTimes, [f64; 2], u64, i128) {
+    /// The step loop of this thread, as named stages.
+    fn run<const ROT: bool, const GRAV: bool>(mut self, steps: u64) -> Done {
         let _bound = if self.team.bind {
             Bound::to_nth_cpu(self.tid, self.team.threads)
         } else {
@@ -411,7 +429,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             self.publish_speeds(s, speeds);
             self.meet();
             if self.team.alarm.raised() {
-                return (self.times, self.bound, s, self.supplied);
+                return self.done(s);
             }
             self.refill_queues(s);
             if self.skin_used_up(s) {
@@ -420,7 +438,18 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             self.pair_forces(s);
         }
         self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
-        (self.times, self.bound, steps, self.supplied)
+        self.done(steps)
+    }
+
+    /// What this thread leaves after `steps` steps.
+    fn done(&self, steps: u64) -> Done {
+        Done {
+            times: self.times,
+            bound: self.bound,
+            steps,
+            supplied: self.supplied,
+            deepest: self.deepest,
+        }
     }
 
     /// Particle pass over the chunks this thread takes: the closing kick of step `gather` (none
@@ -563,6 +592,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             while let Some(c) = team.pair_queue.next(self.tid) {
                 let watch = pair_chunk(&view, arr, touched, c, closed);
                 self.supplied += watch.wall_work;
+                self.deepest = self.deepest.max(watch.worst);
                 if watch.worst > team.overlap {
                     let (seg, ends) = (arr.pair_ranges.get(c), arr.live.get(c));
                     let live = (0..CLASSES).flat_map(|class| seg[class]..ends[class]);
