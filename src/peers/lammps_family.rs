@@ -21,7 +21,6 @@ pub mod dump;
 
 use super::{wall_speeds, Frame, Peer};
 use crate::case::{Case, Tangential};
-use crate::contact::PairForce;
 use crate::io::atomic;
 use crate::state::Motion;
 use crate::state::{Contact, Snapshot};
@@ -358,20 +357,7 @@ fix             still2 top    move linear 0 0 0\n\
             if on_a == Vec3::zeros() {
                 continue;
             }
-            let (p, i, f) = if a < b { (a, b, on_a) } else { (b, a, -on_a) };
-            let n = s.domain.min_image(x[p] - x[i]).normalize();
-            out.push(Contact {
-                p: p as u32,
-                i: i as u32,
-                history: Vec::new(),
-                spring: Vec3::zeros(),
-                force: PairForce {
-                    f,
-                    fn_signed: f.dot(&n),
-                    torque_p: Vec3::zeros(),
-                    torque_i: Vec3::zeros(),
-                },
-            });
+            out.push(super::contact_of(s, a, b, on_a, Vec3::zeros()));
         }
         out.sort_unstable_by_key(|c| (c.p, c.i));
         Ok(out)

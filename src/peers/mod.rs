@@ -21,7 +21,7 @@ pub mod liggghts;
 pub mod yade;
 
 use crate::case::{Case, Scene, Tangential};
-use crate::state::{Contact, Snapshot};
+use crate::state::{Contact, PairForce, Snapshot};
 use crate::Vec3;
 
 /// Every known peer, in the order of listings and default runs. A new peer is one line here.
@@ -144,6 +144,32 @@ pub struct Frame {
     pub x: Vec<Vec3>,
     pub v: Vec<Vec3>,
     pub w: Vec<Vec3>,
+}
+
+/// A peer's contact between particles `a` and `b` (indices of `s`) as a verdem contact: the
+/// lower index is P, and `on_a` (force on `a`) and `spring_on_a` (its elastic spring, length)
+/// are turned to act on P; `fn_signed` is the force along the normal from I to P. Peers give
+/// no history and no torques here.
+pub fn contact_of(s: &Snapshot, a: usize, b: usize, on_a: Vec3, spring_on_a: Vec3) -> Contact {
+    let (p, i, f, spring) = if a < b {
+        (a, b, on_a, spring_on_a)
+    } else {
+        (b, a, -on_a, -spring_on_a)
+    };
+    let x = &s.particles.x;
+    let n = s.domain.min_image(x[p] - x[i]).normalize();
+    Contact {
+        p: p as u32,
+        i: i as u32,
+        history: Vec::new(),
+        spring,
+        force: PairForce {
+            f,
+            fn_signed: f.dot(&n),
+            torque_p: Vec3::zeros(),
+            torque_i: Vec3::zeros(),
+        },
+    }
 }
 
 /// Every known peer.

@@ -31,7 +31,6 @@ use anyhow::{bail, ensure, Context};
 
 use super::{wall_speeds, Frame, Peer};
 use crate::case::{Case, Tangential};
-use crate::contact::PairForce;
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
 use crate::Vec3;
@@ -314,24 +313,7 @@ impl Peer for Yade {
                 path.display()
             );
             let (on_a, spring_a) = (Vec3::new(r[2], r[3], r[4]), Vec3::new(r[5], r[6], r[7]));
-            let (p, i, f, spring) = if a < b {
-                (a, b, on_a, spring_a)
-            } else {
-                (b, a, -on_a, -spring_a)
-            };
-            let n = s.domain.min_image(x[p] - x[i]).normalize();
-            out.push(Contact {
-                p: p as u32,
-                i: i as u32,
-                history: Vec::new(),
-                spring,
-                force: PairForce {
-                    f,
-                    fn_signed: f.dot(&n),
-                    torque_p: Vec3::zeros(),
-                    torque_i: Vec3::zeros(),
-                },
-            });
+            out.push(super::contact_of(s, a, b, on_a, spring_a));
         }
         out.sort_unstable_by_key(|c| (c.p, c.i));
         Ok(out)
