@@ -96,8 +96,9 @@ pub struct Neighbor {
 }
 
 /// `[guard]`: limits of the run guard, which stops a run whose numbers can no longer be
-/// trusted (non-finite velocities and positions are always refused).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+/// trusted (non-finite velocities and positions are always refused). The step runs with it as
+/// it is (`step::Params::guard`).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Guard {
     /// Largest overlap allowed, as a fraction of the smaller radius of the pair (0 < overlap

@@ -9,7 +9,6 @@ use crate::contact::{
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
-use crate::step::guard::GuardLimits;
 use crate::step::{Core, Engine, Simulation};
 use crate::Vec3;
 
@@ -88,7 +87,7 @@ struct BuildSimulation {
     builder: NeighborBuilder,
     threads: usize,
     bind: bool,
-    guard: GuardLimits,
+    guard: case::Guard,
 }
 
 impl LawVisitor for BuildSimulation {
@@ -125,10 +124,7 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
         builder,
         threads: o.threads.unwrap_or(case.run.threads),
         bind: o.bind.unwrap_or(true),
-        guard: GuardLimits {
-            overlap: case.guard.overlap,
-            energy: case.guard.energy,
-        },
+        guard: case.guard,
     };
     with_law(&case.contact, parts)
 }

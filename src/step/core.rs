@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use super::counters::StageTimes;
-use super::guard::{Failure, GuardLimits};
+use super::guard::Failure;
+use crate::case::Guard;
 use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
 use crate::neighbor::NeighborBuilder;
 use crate::state::{Contact, Domain, History, Particles, Snapshot};
@@ -50,7 +51,7 @@ pub struct Params {
     /// Called once a step after the meeting, on thread 0; `None` for a normal run.
     pub meet: Option<MeetHook>,
     /// Limits of the run guard.
-    pub guard: GuardLimits,
+    pub guard: Guard,
 }
 
 /// What the step keeps between steps besides the state: the pair list's builder and plan, the
@@ -122,7 +123,7 @@ impl<H: History> Core<H> {
                 bind: true,
                 setup_advances_history: true,
                 meet: None,
-                guard: GuardLimits::default(),
+                guard: Guard::default(),
             },
             counters: StageTimes::default(),
             failure: None,

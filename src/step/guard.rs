@@ -13,25 +13,6 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
-/// Limits of the run guard.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GuardLimits {
-    /// Largest overlap allowed, as a fraction of the smaller radius of the pair.
-    pub overlap: f64,
-    /// Largest gain of mechanical energy over a window beyond the work supplied, as a fraction
-    /// of the energy at play (see [`super::energy`]).
-    pub energy: f64,
-}
-
-impl Default for GuardLimits {
-    fn default() -> Self {
-        GuardLimits {
-            overlap: crate::case::DEFAULT_GUARD_OVERLAP,
-            energy: crate::case::DEFAULT_GUARD_ENERGY,
-        }
-    }
-}
-
 /// What went wrong, in memory indices (translated to ids when reported).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Breach {
