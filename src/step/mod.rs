@@ -127,6 +127,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
             self.initial_forces();
         }
+        if steps == 0 || self.core.failure.is_some() {
+            return self.core.failure.clone().map_or(Ok(()), Err);
+        }
         // The steps run in windows, each closed by the run guard's energy balance.
         let mut left = steps;
         let mut before = self.energy();
