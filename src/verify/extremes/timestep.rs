@@ -105,6 +105,17 @@ pub fn failure(e: anyhow::Error) -> Failure {
     }
 }
 
+/// Case text `text` with its time step given as `steps_per_collision = per_tc` (its `dt`, if
+/// any, removed).
+fn per_collision(text: &str, per_tc: f64) -> String {
+    set(
+        &unset(text, "run", "dt"),
+        "run",
+        "steps_per_collision",
+        &format!("{per_tc:?}"),
+    )
+}
+
 /// The collision case text of `base_text` with sphere 2 fixed when `wall`.
 fn collision_text(base_text: &str, wall: bool) -> String {
     if !wall {
@@ -126,12 +137,7 @@ fn collisions(inputs: &Inputs, wall: bool) -> anyhow::Result<Vec<MapRow>> {
     let mut rows = Vec::new();
     for per_tc in PER_TC {
         let stable = per_tc > limit;
-        let t = set(
-            &unset(&text, "run", "dt"),
-            "run",
-            "steps_per_collision",
-            &format!("{per_tc:?}"),
-        );
+        let t = per_collision(&text, per_tc);
         let measured = sweep(&base, wall, per_tc, 1.0);
         let did = match parse(&t, &path) {
             Err(refused) => refused,
@@ -321,12 +327,7 @@ pub fn shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     let mut rows = Vec::new();
     for per_tc in [50.0, 10.0, 5.0, 3.0, 2.0, 1.7, 1.5, 1.0, 0.45] {
         let stable = per_tc > limit;
-        let t = set(
-            &unset(&text, "run", "dt"),
-            "run",
-            "steps_per_collision",
-            &format!("{per_tc:?}"),
-        );
+        let t = per_collision(&text, per_tc);
         let measured = shear_run(&base, state, per_tc)?;
         // an accepted case is the base with this step: its run is the measured one
         let did = super::did(&t, &inputs.shear, &measured);
