@@ -7,8 +7,9 @@ use anyhow::bail;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 
-use crate::case::{Case, Scene as SceneSpec};
+use crate::case::{Case, Scene as SceneSpec, Search};
 use crate::io::{mercury, official};
+use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::Domain;
 use crate::state::{Motion, Particles};
 use crate::Vec3;
@@ -234,7 +235,7 @@ fn check_loaded(
         }
     }
     let free = |a: usize| matches!(p.motion[a], Motion::Free);
-    for (a, b) in close_pairs(p, domain) {
+    for (a, b) in overlapping_pairs(p, domain) {
         if !free(a) && !free(b) {
             continue;
         }
@@ -265,44 +266,28 @@ fn check_loaded(
     Ok(())
 }
 
-/// The pairs (a < b) of particles whose centres are closer than the sum of the two largest
-/// radii, found through a grid of cells at least that wide (positions in the box).
-fn close_pairs(p: &Particles, domain: &Domain) -> Vec<(usize, usize)> {
+/// The pairs (a < b, in that order) of overlapping particles, found by the solver's own cell
+/// search (positions in the box).
+fn overlapping_pairs(p: &Particles, domain: &Domain) -> Vec<(usize, usize)> {
     let r_max = p.radius.iter().cloned().fold(0.0, f64::max);
-    let l = domain.lengths();
-    let n = [0, 1, 2].map(|k| ((l[k] / (2.0 * r_max)).floor() as usize).clamp(1, 1 << 10));
-    let cell_of = |x: &Vec3| {
-        [0, 1, 2].map(|k| (((x[k] - domain.lo[k]) / l[k] * n[k] as f64) as usize).min(n[k] - 1))
-    };
-    let mut cells: std::collections::HashMap<[usize; 3], Vec<usize>> = Default::default();
-    for a in 0..p.len() {
-        cells.entry(cell_of(&p.x[a])).or_default().push(a);
-    }
-    let mut out = Vec::new();
-    for a in 0..p.len() {
-        let c = cell_of(&p.x[a]);
-        let mut near: Vec<[usize; 3]> = Vec::with_capacity(27);
-        for d in 0..27 {
-            let o = [d % 3, d / 3 % 3, d / 9].map(|v| v as i64 - 1);
-            let cc = [0, 1, 2].map(|k| {
-                let v = c[k] as i64 + o[k];
-                (domain.periodic[k] || (0..n[k] as i64).contains(&v))
-                    .then(|| v.rem_euclid(n[k] as i64) as usize)
-            });
-            if let [Some(x), Some(y), Some(z)] = cc {
-                if !near.contains(&[x, y, z]) {
-                    near.push([x, y, z]);
-                }
-            }
-        }
-        for cc in near {
-            for &b in cells.get(&cc).into_iter().flatten() {
-                if b > a && domain.min_image(p.x[b] - p.x[a]).norm() < 2.0 * r_max {
-                    out.push((a, b));
-                }
-            }
-        }
-    }
+    let mut builder = NeighborBuilder::new(0.0, 0.0, r_max, Search::Cells);
+    let id: Vec<u32> = (0..p.len() as u32).collect();
+    let mut order = Vec::new();
+    builder.order(domain, &p.x, &id, &mut order);
+    let x: Vec<Vec3> = order.iter().map(|&a| p.x[a as usize]).collect();
+    let radius: Vec<f64> = order.iter().map(|&a| p.radius[a as usize]).collect();
+    let mut list = PairList::default();
+    builder.build(&mut list, domain, &x, &radius, &order, |_, _| true);
+    let mut out: Vec<(usize, usize)> = list
+        .p
+        .iter()
+        .zip(&list.i)
+        .map(|(&m, &n)| {
+            let (a, b) = (order[m as usize] as usize, order[n as usize] as usize);
+            (a.min(b), a.max(b))
+        })
+        .collect();
+    out.sort_unstable();
     out
 }
 
