@@ -142,9 +142,8 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
-        pair_force::<L, PERIODIC>(view, p, i, history, active, out);
-        if s.active[k] {
-            guard_contact::<L, PERIODIC>(view, p, i, &s.out[k], &mut watch);
+        if let Some(delta) = pair_force::<L, PERIODIC>(view, p, i, history, active, out) {
+            guard_contact(view, p, i, delta, &s.out[k], &mut watch);
             // only free particles gather (and clear their flag)
             for q in [p, i] {
                 if view.inv_mass[q] > 0.0 {
@@ -157,6 +156,7 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
 }
 
 /// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
+/// Returns the overlap (length) of a pair in contact.
 ///
 /// # Safety
 /// `p` and `i` index the views, and no thread writes their positions or velocities during the
@@ -169,7 +169,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     history: &mut L::History,
     active: &mut bool,
     out: &mut PairForce,
-) {
+) -> Option<f64> {
     let direct = view.x.get(p) - view.x.get(i);
     let r = if PERIODIC {
         view.domain.min_image(direct)
@@ -182,7 +182,7 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
             *active = false;
             *history = L::History::default();
         }
-        return;
+        return None;
     }
     let input = PairInput {
         r,
@@ -193,10 +193,10 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         w_p: view.w.get(p),
         w_i: view.w.get(i),
     };
-    if let Some(kin) = input.kinematics() {
-        *out = view.law.evaluate(&kin, history, view.dt);
-        *active = true;
-    }
+    let kin = input.kinematics()?;
+    *out = view.law.evaluate(&kin, history, view.dt);
+    *active = true;
+    Some(kin.delta)
 }
 
 /// Whether a contact's force and torques are finite: a NaN or ±∞ component makes their sum
@@ -207,23 +207,24 @@ fn finite(o: &PairForce) -> bool {
     (sum(o.f) + sum(o.torque_p) + sum(o.torque_i)).is_finite()
 }
 
-/// The run guard, for a contact only, out of line so that the pair loop's code stays as it is
-/// without the guard: raises `watch.worst` to the contact's overlap as a fraction of its smaller
-/// radius (found again from the positions), or to infinity when its force or torques are not
+/// The run guard, for a contact of overlap `delta` (length): raises `watch.worst` to the
+/// overlap as a fraction of the smaller radius, or to infinity when the force or torques are not
 /// finite; and adds a wall's work on its free partner over this step, F·U·dt with F the force on
-/// the free particle and U the wall's velocity.
+/// the free particle and U the wall's velocity. Inline, with no call in the pair loop: a call
+/// there makes the loop keep its invariants in memory for every pair, touching or not.
 ///
 /// # Safety
 /// As [`pair_force`].
-#[inline(never)]
-unsafe fn guard_contact<L, const PERIODIC: bool>(
+#[inline(always)]
+unsafe fn guard_contact<L>(
     view: &PairView<'_, L>,
     p: usize,
     i: usize,
+    delta: f64,
     out: &PairForce,
     watch: &mut Watch,
 ) {
-    let depth = overlap::<L, PERIODIC>(view, p, i) / view.radius[p].min(view.radius[i]);
+    let depth = delta / view.radius[p].min(view.radius[i]);
     watch.worst = if finite(out) {
         watch.worst.max(depth)
     } else {
