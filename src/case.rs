@@ -110,6 +110,10 @@ pub struct Guard {
     /// [`DEFAULT_GUARD_ENERGY`]).
     #[serde(default = "default_guard_energy")]
     pub energy: f64,
+    /// Largest energy a contact may give its particles beyond what it took from them and what
+    /// its springs held, as a fraction of what it took (> 0; default [`DEFAULT_GUARD_CONTACT`]).
+    #[serde(default = "default_guard_contact")]
+    pub contact: f64,
 }
 
 /// Default of `[guard] overlap`. The benchmark's largest overlaps are about 1 % of the radius
@@ -132,11 +136,19 @@ fn default_guard_energy() -> f64 {
     DEFAULT_GUARD_ENERGY
 }
 
+/// Default of `[guard] contact`.
+pub const DEFAULT_GUARD_CONTACT: f64 = 0.01;
+
+fn default_guard_contact() -> f64 {
+    DEFAULT_GUARD_CONTACT
+}
+
 impl Default for Guard {
     fn default() -> Self {
         Guard {
             overlap: DEFAULT_GUARD_OVERLAP,
             energy: DEFAULT_GUARD_ENERGY,
+            contact: DEFAULT_GUARD_CONTACT,
         }
     }
 }
@@ -422,6 +434,7 @@ impl Case {
         positive("neighbor", "skin", self.neighbor.skin)?;
         positive("guard", "overlap", self.guard.overlap)?;
         positive("guard", "energy", self.guard.energy)?;
+        positive("guard", "contact", self.guard.contact)?;
         if self.guard.overlap > 1.0 {
             return Err(err(
                 "guard",

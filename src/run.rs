@@ -50,6 +50,8 @@ pub struct RunSummary {
     pub interrupted: bool,
     /// Largest overlap of any contact, as a fraction of the pair's smaller radius.
     pub deepest_overlap: f64,
+    /// Largest excess of a contact's energy account, as a fraction of the energy it took.
+    pub largest_excess: f64,
 }
 
 /// Steps of the full bumpy-shear benchmark (`cases/shear_flow.toml`, `docs/benchmark.md`: Nt).
@@ -295,6 +297,7 @@ pub fn run(
         saves,
         interrupted,
         deepest_overlap: engine.deepest_overlap(),
+        largest_excess: engine.largest_excess(),
     })
 }
 

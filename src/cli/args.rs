@@ -39,6 +39,10 @@ pub struct Common {
     /// as a fraction of the energy at play (> 0; replaces the case's `[guard] energy`).
     #[arg(long, allow_negative_numbers = true, value_parser = positive)]
     guard_energy: Option<f64>,
+    /// The run guard's largest energy a contact may give beyond what it took and its springs
+    /// held, as a fraction of what it took (> 0; replaces the case's `[guard] contact`).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
+    guard_contact: Option<f64>,
 }
 
 impl Common {
@@ -51,6 +55,9 @@ impl Common {
         }
         if let Some(energy) = self.guard_energy {
             case.guard.energy = energy;
+        }
+        if let Some(contact) = self.guard_contact {
+            case.guard.contact = contact;
         }
         let scene = scene::build(&case, self.init.as_deref())?;
         let o = Overrides {

@@ -172,6 +172,12 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         ms(st.wait),
         engine.pair_count()
     );
+    let guard = engine.params().guard;
+    println!(
+        "run guard: largest overlap {:.3e} of the smaller radius (limit {}), largest energy a \
+         contact gave beyond what it took {:.3e} of what it took (limit {})",
+        s.deepest_overlap, guard.overlap, s.largest_excess, guard.contact
+    );
     println!("state hash: {}", s.hash);
     run::write_summary(&opts.out_dir, &case.name, &s, threads)?;
     if let Some(png) = particles_picture(&opts, engine.as_ref())? {

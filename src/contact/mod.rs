@@ -127,6 +127,14 @@ pub trait ContactLaw: Send + Sync {
     /// (energy units): what its springs can give back to the particles. The run guard's energy
     /// balance counts it, so that a packing releasing its springs is not taken for a gain.
     fn stored_energy(&self, delta: f64, history: &Self::History) -> f64;
+
+    /// The part of [`ContactLaw::stored_energy`] a function of the overlap `delta` alone
+    /// (length, > 0; energy units): what the normal spring holds and gives back exactly as the
+    /// overlap closes. The run guard's contact accounts count it at every step. By default the
+    /// energy held with a fresh history.
+    fn normal_energy(&self, delta: f64) -> f64 {
+        self.stored_energy(delta, &Self::History::default())
+    }
 }
 
 /// A normal model and a tangential model composed into a contact law.
@@ -175,6 +183,10 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
 
     fn stored_energy(&self, delta: f64, xi: &T::History) -> f64 {
         self.normal.stored_energy(delta) + self.tangential.stored_energy(xi)
+    }
+
+    fn normal_energy(&self, delta: f64) -> f64 {
+        self.normal.stored_energy(delta)
     }
 }
 

@@ -11,7 +11,7 @@
 use std::sync::atomic::AtomicBool;
 
 use super::{NeighborBuilder, PairList};
-use crate::state::{Domain, History, Motion, PairForce, Particles};
+use crate::state::{Domain, History, Motion, PairForce, Particles, Tally};
 use crate::team::{balanced_ranges, Crew, Shared, SharedSlice};
 use crate::Vec3;
 
@@ -46,8 +46,8 @@ pub fn key(p: u32, i: u32) -> u64 {
     ((p as u64) << 32) | i as u64
 }
 
-/// The candidate pairs in memory indices and each pair's slots: its contact history `H` and the
-/// force of its last evaluation.
+/// The candidate pairs in memory indices and each pair's slots: its contact history `H`, the
+/// force of its last evaluation and the run guard's energy account of the contact.
 #[derive(Clone, Debug)]
 pub struct Pairs<H> {
     /// Candidate pairs (within r_P + r_I + skin at the last build).
@@ -58,8 +58,12 @@ pub struct Pairs<H> {
     pub active: Vec<bool>,
     /// Force and torques of each active pair at the last force evaluation.
     pub out: Vec<PairForce>,
-    /// The histories of the last build's slots while a rebuild carries them over.
+    /// The run guard's energy account of each active pair ([`Tally`]).
+    pub tally: Vec<Tally>,
+    /// The last build's slots (history, force, account) while a rebuild carries them over.
     carried: Vec<H>,
+    carried_out: Vec<PairForce>,
+    carried_tally: Vec<Tally>,
 }
 
 impl<H> Default for Pairs<H> {
@@ -69,7 +73,10 @@ impl<H> Default for Pairs<H> {
             history: Vec::new(),
             active: Vec::new(),
             out: Vec::new(),
+            tally: Vec::new(),
             carried: Vec::new(),
+            carried_out: Vec::new(),
+            carried_tally: Vec::new(),
         }
     }
 }
@@ -199,8 +206,11 @@ pub struct ListState<'a, H> {
     pub builder: &'a mut NeighborBuilder,
     pub plan: &'a mut Plan,
     pub flags: &'a mut Flags,
-    /// The view the crew writes the pairs' histories through while sorting the pair chunks.
+    /// The views the crew writes the pairs' carried slots through while sorting the pair
+    /// chunks.
     pub history: SharedSlice<H>,
+    pub out: SharedSlice<PairForce>,
+    pub tally: SharedSlice<Tally>,
 }
 
 impl<'a, H> ListState<'a, H> {
@@ -221,6 +231,8 @@ impl<'a, H> ListState<'a, H> {
             plan,
             flags,
             history: SharedSlice::default(),
+            out: SharedSlice::default(),
+            tally: SharedSlice::default(),
         }
     }
 }
@@ -339,7 +351,10 @@ impl<H: History> ListState<'_, H> {
             }
         }
         s.old_keys.sort_unstable();
-        std::mem::swap(&mut self.pairs.carried, &mut self.pairs.history);
+        let pairs = &mut *self.pairs;
+        std::mem::swap(&mut pairs.carried, &mut pairs.history);
+        std::mem::swap(&mut pairs.carried_out, &mut pairs.out);
+        std::mem::swap(&mut pairs.carried_tally, &mut pairs.tally);
         // Memory order by cell; the builder is then ready to search the re-ordered particles.
         self.builder
             .order(domain, &self.particles.x, self.id, &mut s.order);
@@ -435,6 +450,7 @@ impl<H: History> ListState<'_, H> {
         pairs.history.resize(n_pairs, H::default());
         pairs.active.resize(n_pairs, false);
         pairs.out.resize(n_pairs, PairForce::default());
+        pairs.tally.resize(n_pairs, Tally::default());
         s.views = Views {
             bin: SharedSlice::of(&mut s.bin),
             sorted: SharedSlice::of(&mut s.sorted),
@@ -447,6 +463,8 @@ impl<H: History> ListState<'_, H> {
             ..Views::default()
         };
         self.history = SharedSlice::of(&mut pairs.history);
+        self.out = SharedSlice::of(&mut pairs.out);
+        self.tally = SharedSlice::of(&mut pairs.tally);
     }
 
     /// Parallel phase of a rebuild: chunk `part` of the pairs in its final order and with its
@@ -527,7 +545,9 @@ impl<H: History> ListState<'_, H> {
         }
         *v.pair_hull.at_mut(part) = hull;
         let (history, active) = (self.history.slice_mut(pa..pb), v.active.slice_mut(pa..pb));
+        let (out, tally) = (self.out.slice_mut(pa..pb), self.tally.slice_mut(pa..pb));
         history.fill(H::default());
+        tally.fill(Tally::default());
         active.fill(false);
         if s.old_keys.is_empty() {
             return;
@@ -543,7 +563,10 @@ impl<H: History> ListState<'_, H> {
             }
             let (p, i) = (self.id[pm], self.id[im]);
             if let Ok(o) = s.old_keys.binary_search_by_key(&key(p, i), |e| e.0) {
-                history[j] = self.pairs.carried[s.old_keys[o].1 as usize];
+                let from = s.old_keys[o].1 as usize;
+                history[j] = self.pairs.carried[from];
+                out[j] = self.pairs.carried_out[from];
+                tally[j] = self.pairs.carried_tally[from];
                 active[j] = true;
             }
         }
@@ -568,6 +591,8 @@ impl<H: History> ListState<'_, H> {
         list.index(self.particles.len(), self.id, &mut s.fill);
         s.views = Views::default();
         self.history = SharedSlice::default();
+        self.out = SharedSlice::default();
+        self.tally = SharedSlice::default();
         plan.reset_live();
     }
 }

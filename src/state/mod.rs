@@ -3,10 +3,12 @@
 pub mod domain;
 pub mod history;
 pub mod snapshot;
+pub mod tally;
 
 pub use domain::Domain;
 pub use history::History;
 pub use snapshot::{Contact, PairForce, Snapshot};
+pub use tally::Tally;
 
 use crate::Vec3;
 

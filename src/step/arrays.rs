@@ -6,8 +6,8 @@
 //! - the particle pass writes the particle arrays (`x`, `v`, `w`, `f`, `t`, `quiet`) of the
 //!   chunks it takes only; it reads the slots (`active`, `out`) of its particles' pairs once the
 //!   pair chunks that hold them are marked done;
-//! - the pair pass writes the slots (`history`, `active`, `out`) of its chunk's pairs and its chunk's
-//!   `live` ends only, and reads the positions and velocities of its pairs' particles, whose
+//! - the pair pass writes the slots (`history`, `active`, `out`, `tally`) of its chunk's pairs and
+//!   its chunk's `live` ends only, and reads the positions and velocities of its pairs' particles, whose
 //!   particle chunk cannot start until this pair chunk is marked done;
 //! - `touched` flags are atomics, set by the pair pass, cleared by the particle pass;
 //! - everything else (radii, masses, flags of the build, the pair list, the plan) is written only
@@ -16,7 +16,7 @@
 use std::sync::atomic::AtomicBool;
 
 use crate::neighbor::rebuild::{ListState, CLASSES};
-use crate::state::PairForce;
+use crate::state::{PairForce, Tally};
 use crate::team::SharedSlice;
 use crate::Vec3;
 
@@ -42,6 +42,7 @@ pub(super) struct Arrays<H> {
     pub history: SharedSlice<H>,
     pub active: SharedSlice<bool>,
     pub out: SharedSlice<PairForce>,
+    pub tally: SharedSlice<Tally>,
     pub particle_chunks: SharedSlice<(usize, usize)>,
     pub pair_ranges: SharedSlice<[usize; CLASSES + 1]>,
     pub live: SharedSlice<[usize; CLASSES]>,
@@ -86,6 +87,7 @@ impl<H> Arrays<H> {
             history: SharedSlice::of(&mut pairs.history),
             active: SharedSlice::of(&mut pairs.active),
             out: SharedSlice::of(&mut pairs.out),
+            tally: SharedSlice::of(&mut pairs.tally),
             particle_chunks: SharedSlice::of(&mut plan.particle_chunks),
             pair_ranges: SharedSlice::of(&mut plan.pair_ranges),
             live: SharedSlice::of(&mut plan.live),

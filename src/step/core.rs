@@ -78,6 +78,9 @@ pub struct Core<H> {
     /// Largest overlap of any contact in the pair passes so far, as a fraction of the smaller
     /// radius of the pair.
     pub deepest: f64,
+    /// Largest excess of a contact's energy account in the pair passes so far, as a fraction of
+    /// what the contact took.
+    pub pumped: f64,
     pub(super) work: Workspace,
 }
 
@@ -128,6 +131,7 @@ impl<H: History> Core<H> {
             counters: StageTimes::default(),
             failure: None,
             deepest: 0.0,
+            pumped: 0.0,
             work: Workspace {
                 moved_bound: [0.0; 2],
                 builder,

@@ -7,7 +7,7 @@ use super::arrays::Arrays;
 use super::guard::Breach;
 use crate::contact::{ContactLaw, PairInput};
 use crate::neighbor::rebuild::CLASSES;
-use crate::state::{Domain, PairForce};
+use crate::state::{Domain, PairForce, Tally};
 use crate::team::SharedSlice;
 use crate::Vec3;
 
@@ -24,23 +24,39 @@ pub(super) struct PairView<'a, L> {
     pub inv_mass: &'a [f64],
     /// Largest overlap allowed, as a fraction of the smaller radius (the run guard).
     pub overlap: f64,
+    /// Largest excess of a contact's energy account allowed, as a fraction of the energy it took
+    /// (the run guard; [`Tally::book`]).
+    pub excess: f64,
 }
 
 /// What the run guard learns from the contacts of a pass: the largest overlap as a fraction of
 /// the smaller radius (0 without a contact; infinite when a contact's force or torque is not
-/// finite), and the work the prescribed particles did on the free ones this step, in fixed point
+/// finite), the largest excess of a contact's energy account as a fraction of the energy it took
+/// (0 when none gave out more than it took; infinite when one gave energy it never took), and the
+/// work the prescribed particles did on the free ones this step, in fixed point
 /// ([`super::energy::fixed`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct Watch {
     pub worst: f64,
+    pub pumped: f64,
     pub wall_work: i128,
 }
 
 impl Watch {
     fn add(&mut self, other: Watch) {
         self.worst = self.worst.max(other.worst);
+        self.pumped = self.pumped.max(other.pumped);
         self.wall_work += other.wall_work;
     }
+}
+
+/// A pair in contact after its force evaluation, for the run guard: its overlap `delta`
+/// (length) and the power (energy/time) its previous force delivers at the velocities of this
+/// evaluation (`None` for a new contact, not in contact at the evaluation before).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Touch {
+    pub delta: f64,
+    pub before: Option<f64>,
 }
 
 /// A range of pairs and their slots.
@@ -50,6 +66,7 @@ pub(super) struct PairSlots<'a, H> {
     pub history: &'a mut [H],
     pub active: &'a mut [bool],
     pub out: &'a mut [PairForce],
+    pub tally: &'a mut [Tally],
 }
 
 /// Pair pass over pair chunk `c`: first its live ends are grown to every pair whose gap at the
@@ -92,6 +109,7 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
             history: arr.history.slice_mut(a..b),
             active: arr.active.slice_mut(a..b),
             out: arr.out.slice_mut(a..b),
+            tally: arr.tally.slice_mut(a..b),
         };
         let seen = if class < CLASSES / 2 {
             pair_range::<L, false>(view, touched, slots)
@@ -104,8 +122,9 @@ pub(super) unsafe fn pair_chunk<L: ContactLaw>(
 }
 
 /// The run guard's report of the first contact among the pairs `slots` whose force or torque is
-/// not finite or whose overlap exceeds `view.overlap` times its smaller radius, found again from
-/// the slots and positions the pair pass left.
+/// not finite, whose overlap exceeds `view.overlap` times its smaller radius, or whose energy
+/// account's excess exceeds `view.excess` times the energy it took, found again from the slots
+/// and positions the pair pass left.
 ///
 /// # Safety
 /// As [`pair_chunk`] for the chunks holding these pairs, after it, before their particles move.
@@ -122,7 +141,18 @@ pub(super) unsafe fn contact_breach<L: ContactLaw>(
         }
         let delta = overlap::<L, true>(view, p, i);
         let limit = view.overlap * view.radius[p].min(view.radius[i]);
-        (delta > limit).then_some(Breach::Overlap { p, i, delta, limit })
+        if delta > limit {
+            return Some(Breach::Overlap { p, i, delta, limit });
+        }
+        let tally = arr.tally.get(k);
+        let excess = tally.excess(view.law.normal_energy(delta));
+        (tally.open && excess > view.excess * tally.taken).then_some(Breach::Pumped {
+            p,
+            i,
+            excess,
+            taken: tally.taken,
+            limit: view.excess * tally.taken,
+        })
     })
 }
 
@@ -136,27 +166,23 @@ pub(super) unsafe fn contact_breach<L: ContactLaw>(
 pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
-    s: PairSlots<'_, L::History>,
+    mut s: PairSlots<'_, L::History>,
 ) -> Watch {
     let mut watch = Watch::default();
     for k in 0..s.p.len() {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
-        let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
-        if let Some(delta) = pair_force::<L, PERIODIC>(view, p, i, history, active, out) {
-            guard_contact(view, p, i, delta, &s.out[k], &mut watch);
-            // only free particles gather (and clear their flag)
-            for q in [p, i] {
-                if view.inv_mass[q] > 0.0 {
-                    touched[q].store(true, Ordering::Relaxed);
-                }
-            }
-        }
+        let Some(r) = touching::<L, PERIODIC>(view, p, i) else {
+            forget(&mut s.history[k], &mut s.active[k]);
+            continue;
+        };
+        contact(view, touched, p, i, r, k, &mut s, &mut watch);
     }
     watch
 }
 
-/// Force of pair (p, i) into its slot; a pair that is not touching forgets its history.
-/// Returns the overlap (length) of a pair in contact.
+/// Force of pair (p, i) into its slot (history, active flag, force); a pair that is not
+/// touching forgets its history. Returns the overlap (length) of a pair in contact. The run
+/// guard is not consulted (the forces before the first step).
 ///
 /// # Safety
 /// `p` and `i` index the views, and no thread writes their positions or velocities during the
@@ -166,10 +192,26 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     view: &PairView<'_, L>,
     p: usize,
     i: usize,
-    history: &mut L::History,
-    active: &mut bool,
-    out: &mut PairForce,
+    slot: (&mut L::History, &mut bool, &mut PairForce),
 ) -> Option<f64> {
+    let Some(r) = touching::<L, PERIODIC>(view, p, i) else {
+        forget(slot.0, slot.1);
+        return None;
+    };
+    evaluate(view, p, i, r, slot).map(|touch| touch.delta)
+}
+
+/// The separation x_P − x_I of pair (p, i) (minimum image with `PERIODIC`), if the spheres
+/// overlap.
+///
+/// # Safety
+/// As [`pair_force`].
+#[inline(always)]
+unsafe fn touching<L, const PERIODIC: bool>(
+    view: &PairView<'_, L>,
+    p: usize,
+    i: usize,
+) -> Option<Vec3> {
     let direct = view.x.get(p) - view.x.get(i);
     let r = if PERIODIC {
         view.domain.min_image(direct)
@@ -177,13 +219,62 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         direct
     };
     let sum = view.radius[p] + view.radius[i];
-    if r.norm_squared() >= sum * sum {
-        if *active {
-            *active = false;
-            *history = L::History::default();
-        }
-        return None;
+    (r.norm_squared() < sum * sum).then_some(r)
+}
+
+/// A pair that is not touching: an active one forgets its history.
+#[inline(always)]
+fn forget<H: Default>(history: &mut H, active: &mut bool) {
+    if *active {
+        *active = false;
+        *history = H::default();
     }
+}
+
+/// The force of the contact in slot `k` of `s`, its run guard and its particles' `touched`
+/// flags, out of line: the loop
+/// over all pairs then keeps its registers for the pairs that do not touch, the great majority.
+///
+/// # Safety
+/// As [`pair_force`].
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+unsafe fn contact<L: ContactLaw>(
+    view: &PairView<'_, L>,
+    touched: &[AtomicBool],
+    p: usize,
+    i: usize,
+    r: Vec3,
+    k: usize,
+    s: &mut PairSlots<'_, L::History>,
+    watch: &mut Watch,
+) {
+    let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
+    let Some(touch) = evaluate(view, p, i, r, (history, active, out)) else {
+        return;
+    };
+    guard_contact(view, p, i, touch, (history, out, &mut s.tally[k]), watch);
+    // only free particles gather (and clear their flag)
+    for q in [p, i] {
+        if view.inv_mass[q] > 0.0 {
+            touched[q].store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// The force of pair (p, i) at separation `r` (overlapping) into its slot, its history updated
+/// over the step; returns what the run guard needs of it.
+///
+/// # Safety
+/// As [`pair_force`].
+#[inline(always)]
+unsafe fn evaluate<L: ContactLaw>(
+    view: &PairView<'_, L>,
+    p: usize,
+    i: usize,
+    r: Vec3,
+    (history, active, out): (&mut L::History, &mut bool, &mut PairForce),
+) -> Option<Touch> {
     let input = PairInput {
         r,
         rad_p: view.radius[p],
@@ -194,9 +285,20 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
         w_i: view.w.get(i),
     };
     let kin = input.kinematics()?;
+    let before = active.then(|| power(out, [input.v_p, input.v_i, input.w_p, input.w_i]));
     *out = view.law.evaluate(&kin, history, view.dt);
     *active = true;
-    Some(kin.delta)
+    Some(Touch {
+        delta: kin.delta,
+        before,
+    })
+}
+
+/// The power (energy/time) force `o` delivers to the pair at velocities [v_P, v_I, ω_P, ω_I]:
+/// F·(v_P − v_I) + T_P·ω_P + T_I·ω_I.
+#[inline(always)]
+fn power(o: &PairForce, [v_p, v_i, w_p, w_i]: [Vec3; 4]) -> f64 {
+    o.f.dot(&(v_p - v_i)) + o.torque_p.dot(&w_p) + o.torque_i.dot(&w_i)
 }
 
 /// Whether a contact's force and torques are finite: a NaN or ±∞ component makes their sum
@@ -207,34 +309,55 @@ fn finite(o: &PairForce) -> bool {
     (sum(o.f) + sum(o.torque_p) + sum(o.torque_i)).is_finite()
 }
 
-/// The run guard, for a contact of overlap `delta` (length): raises `watch.worst` to the
-/// overlap as a fraction of the smaller radius, or to infinity when the force or torques are not
-/// finite; and adds a wall's work on its free partner over this step, F·U·dt with F the force on
-/// the free particle and U the wall's velocity. Inline, with no call in the pair loop: a call
-/// there makes the loop keep its invariants in memory for every pair, touching or not.
+/// The run guard, for a contact just evaluated (`touch`, and its slot: history, force and energy
+/// account): raises `watch.worst` to the overlap as a fraction of the smaller radius, or to
+/// infinity when the force or torques are not finite; books the step's work in the account and
+/// raises `watch.pumped` to its excess as a fraction of what it took; and adds a wall's work on
+/// its free partner over this step, F·U·dt with F the force on the free particle and U the
+/// wall's velocity. Inline, with no call in the pair loop: a call there makes the loop keep its
+/// invariants in memory for every pair, touching or not.
 ///
 /// # Safety
 /// As [`pair_force`].
 #[inline(always)]
-unsafe fn guard_contact<L>(
+unsafe fn guard_contact<L: ContactLaw>(
     view: &PairView<'_, L>,
     p: usize,
     i: usize,
-    delta: f64,
-    out: &PairForce,
+    touch: Touch,
+    (history, out, tally): (&L::History, &PairForce, &mut Tally),
     watch: &mut Watch,
 ) {
-    let depth = delta / view.radius[p].min(view.radius[i]);
+    let depth = touch.delta / view.radius[p].min(view.radius[i]);
     watch.worst = if finite(out) {
         watch.worst.max(depth)
     } else {
         f64::INFINITY
     };
+    let (free_p, free_i) = (view.inv_mass[p] > 0.0, view.inv_mass[i] > 0.0);
+    if !free_p && !free_i {
+        // two prescribed particles: no energy reaches a free one
+        return;
+    }
+    let at = [view.v.get(p), view.v.get(i), view.w.get(p), view.w.get(i)];
+    // F_n·(v_(n−½) + v_(n+½))·dt/2: half of each of the two forces at these velocities.
+    let work = 0.5 * view.dt * (touch.before.unwrap_or(0.0) + power(out, at));
+    let normal = view.law.normal_energy(touch.delta);
+    let new = touch.before.is_none();
+    let stored = if tally.open || new {
+        normal
+    } else {
+        view.law.stored_energy(touch.delta, history)
+    };
+    let excess = tally.book(work, normal, stored, new);
+    if excess > 0.0 {
+        watch.pumped = watch.pumped.max(excess / tally.taken);
+    }
     // out.f is the force on P; the force on I is −out.f.
-    let power = if view.inv_mass[p] == 0.0 {
-        -out.f.dot(&view.v.get(p))
-    } else if view.inv_mass[i] == 0.0 {
-        out.f.dot(&view.v.get(i))
+    let power = if !free_p {
+        -out.f.dot(&at[0])
+    } else if !free_i {
+        out.f.dot(&at[1])
     } else {
         return;
     };

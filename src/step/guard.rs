@@ -6,6 +6,9 @@
 //!   and angular velocity is finite at the start of each run;
 //! - no overlap exceeds a fraction of the smaller radius (checked in the pair pass for the
 //!   pairs in contact only, and before the first step);
+//! - no contact gives its particles more energy than it took from them and than its springs
+//!   held, beyond a fraction of what it took (every contact keeps an energy account,
+//!   [`crate::state::Tally`], booked in the pair pass);
 //! - no free particle is outside the box along a walled axis or has a non-finite position
 //!   (checked at every pair-list rebuild, which visits every particle anyway: a particle moves
 //!   less than a skin between two rebuilds).
@@ -25,6 +28,15 @@ pub(super) enum Breach {
         p: usize,
         i: usize,
         delta: f64,
+        limit: f64,
+    },
+    /// A contact between particles `p` and `i` whose energy account shows an `excess` (energy
+    /// units) beyond `limit`, having taken `taken` from them.
+    Pumped {
+        p: usize,
+        i: usize,
+        excess: f64,
+        taken: f64,
         limit: f64,
     },
     /// A position outside the box along walled axis `axis` (0, 1, 2), or not finite.
@@ -144,6 +156,23 @@ impl Breach {
                      smaller radius)"
                 ),
                 UNSTABLE,
+            ),
+            Breach::Pumped {
+                p,
+                i,
+                excess,
+                taken,
+                limit,
+            } => (
+                vec![p, i],
+                format!(
+                    "the contact gave its particles {excess:e} more energy than it took from them \
+                     ({taken:e}) and its springs held, beyond the limit {limit:e} (guard.contact \
+                     times the energy it took)"
+                ),
+                "a contact law that is not dissipative, or an explicit scheme near its limit: \
+                 check the law's parameters (a negative damping, a tangential convention that \
+                 pumps energy), or use a smaller time step (run.steps_per_collision)",
             ),
             Breach::Outside { particle, axis, x } => (
                 vec![particle],

@@ -80,6 +80,10 @@ pub trait Engine: Send {
     /// Largest overlap of any contact in any step run so far, as a fraction of the pair's
     /// smaller radius (0 before the first step; the guard stops a run beyond `[guard] overlap`).
     fn deepest_overlap(&self) -> f64;
+    /// Largest excess of a contact's energy account in any step run so far, as a fraction of
+    /// the energy the contact took (0 when none gave out more than it took; the guard stops a
+    /// run beyond `[guard] contact`).
+    fn largest_excess(&self) -> f64;
     /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
     /// with the reason, when the run guard finds a number that cannot be trusted; after that
     /// every call fails the same way.
@@ -122,6 +126,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn deepest_overlap(&self) -> f64 {
         self.core.deepest
+    }
+    fn largest_excess(&self) -> f64 {
+        self.core.pumped
     }
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
@@ -232,12 +239,12 @@ impl<L: ContactLaw> Simulation<L> {
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
                 overlap: self.core.params.guard.overlap,
+                excess: self.core.params.guard.contact,
             };
             for k in 0..arr.p.len() {
                 let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
-                let history = arr.history.at_mut(k);
-                let (active, out) = (arr.active.at_mut(k), arr.out.at_mut(k));
-                pair_force::<L, true>(&view, p, i, history, active, out);
+                let slot = (arr.history.at_mut(k), arr.active.at_mut(k), arr.out.at_mut(k));
+                pair_force::<L, true>(&view, p, i, slot);
             }
             if arr.active.slice(0..arr.active.len()).contains(&true) {
                 if let Some(b) = contact_breach(&view, &arr, 0..arr.p.len()) {
@@ -278,7 +285,7 @@ impl<L: ContactLaw> Simulation<L> {
         let domain = core.state.domain.clone();
         let params = &core.params;
         let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
-        let overlap = params.guard.overlap;
+        let guard = params.guard;
         let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
         let periodic_gravity = params
             .gravity
@@ -301,7 +308,7 @@ impl<L: ContactLaw> Simulation<L> {
             arrays,
             meet,
             law: &self.law,
-            overlap,
+            guard,
             alarm: Alarm::default(),
             kick: Kick {
                 domain: &domain,
@@ -328,6 +335,7 @@ impl<L: ContactLaw> Simulation<L> {
                     // an integer sum: the same in any order of the threads
                     mine.supplied += theirs.supplied;
                     mine.deepest = mine.deepest.max(theirs.deepest);
+                    mine.pumped = mine.pumped.max(theirs.pumped);
                 }
                 mine
             })
@@ -338,6 +346,7 @@ impl<L: ContactLaw> Simulation<L> {
         core.counters.rebuilds += done.times.rebuilds;
         core.work.moved_bound = done.bound;
         core.deepest = core.deepest.max(done.deepest);
+        core.pumped = core.pumped.max(done.pumped);
         for _ in 0..done.steps {
             core.state.time += dt;
         }
@@ -354,13 +363,15 @@ impl<L: ContactLaw> Simulation<L> {
 
 /// What a thread's run leaves: its counters, the displacement bounds at the end, the steps
 /// completed (fewer than asked when the run guard stops the run: every thread stops at the same
-/// meeting), the work supplied in its passes (fixed point) and the largest overlap it saw.
+/// meeting), the work supplied in its passes (fixed point), the largest overlap and the largest
+/// excess of a contact's energy account it saw.
 struct Done {
     times: StageTimes,
     bound: [f64; 2],
     steps: u64,
     supplied: i128,
     deepest: f64,
+    pumped: f64,
 }
 
 /// What the threads of a run share.
@@ -380,8 +391,8 @@ struct Team<'a, L: ContactLaw> {
     arrays: Shared<Arrays<L::History>>,
     meet: Option<MeetHook>,
     law: &'a L,
-    /// Largest overlap allowed, as a fraction of the smaller radius.
-    overlap: f64,
+    /// Limits of the run guard.
+    guard: crate::case::Guard,
     /// The first breach of the run guard's limits.
     alarm: Alarm,
     kick: Kick<'a>,
@@ -403,6 +414,9 @@ struct Worker<'t, 'a, L: ContactLaw> {
     supplied: i128,
     /// Largest overlap of its pair passes, as a fraction of the smaller radius.
     deepest: f64,
+    /// Largest excess of a contact's energy account in its pair passes, as a fraction of what
+    /// the contact took.
+    pumped: f64,
 }
 
 impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
@@ -417,6 +431,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             laps: Laps::new(tid == 0),
             supplied: 0,
             deepest: 0.0,
+            pumped: 0.0,
         }
     }
 
@@ -452,6 +467,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             steps,
             supplied: self.supplied,
             deepest: self.deepest,
+            pumped: self.pumped,
         }
     }
 
@@ -589,14 +605,16 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                 w: arr.w,
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
-                overlap: team.overlap,
+                overlap: team.guard.overlap,
+                excess: team.guard.contact,
             };
             let touched = arr.touched.slice(0..n);
             while let Some(c) = team.pair_queue.next(self.tid) {
                 let watch = pair_chunk(&view, arr, touched, c, closed);
                 self.supplied += watch.wall_work;
                 self.deepest = self.deepest.max(watch.worst);
-                if watch.worst > team.overlap {
+                self.pumped = self.pumped.max(watch.pumped);
+                if watch.worst > team.guard.overlap || watch.pumped > team.guard.contact {
                     let (seg, ends) = (arr.pair_ranges.get(c), arr.live.get(c));
                     let live = (0..CLASSES).flat_map(|class| seg[class]..ends[class]);
                     if let Some(b) = contact_breach(&view, arr, live) {
