@@ -146,35 +146,67 @@ impl Limit {
 /// mid-points of equal parts of a step).
 const ONSET_PHASES: usize = 16;
 
-/// The restitution coefficient of verdem's scheme for one head-on collision of effective mass
-/// `meff` (mass) under the linear spring–dashpot `s` (unclipped, as verdem's default law) at
-/// step `dt` (time), the spheres touching 1 − `phase` (0 < phase ≤ 1) of a step after the start
-/// of a step, so that they overlap by `phase`·u·dt at its end: the scheme of this module's head, run on the overlap δ (rate u = dδ/dt,
-/// force k·δ + γ·u_{n+1/2} while δ > 0) until the spheres part. The restitution is linear, so
-/// the speed does not matter; `None` when the step is unstable (no parting within 10⁶ steps).
-pub fn discrete_restitution(meff: f64, s: Spring, dt: f64, phase: f64) -> Option<f64> {
+/// What one head-on collision of verdem's scheme gives (see [`discrete_collision`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteCollision {
+    /// Restitution coefficient −u_after/u_before (dimensionless).
+    pub e: f64,
+    /// Steps that end with the spheres overlapping (the contact's duration in steps).
+    pub steps_in_contact: u64,
+    /// Largest overlap at the end of a step, per unit impact speed (time).
+    pub delta_max_per_speed: f64,
+}
+
+/// One head-on collision of effective mass `meff` (mass) under the linear spring–dashpot `s`
+/// at step `dt` (time), with the force clipped at 0 when `clip` (else the attractive tail is
+/// kept, as verdem's default law), the spheres touching 1 − `phase` (0 < phase ≤ 1) of a step
+/// after the start of a step, so that they overlap by `phase`·u·dt at its end: the scheme of
+/// this module's head, run on the overlap δ (rate u = dδ/dt, force k·δ + γ·u_{n+1/2} while
+/// δ > 0) until the spheres part. The collision is linear in the impact speed, so the overlap
+/// is returned per unit speed; `None` when the step is unstable (no parting within 10⁶ steps).
+pub fn discrete_collision(
+    meff: f64,
+    s: Spring,
+    dt: f64,
+    phase: f64,
+    clip: bool,
+) -> Option<DiscreteCollision> {
     let u0 = 1.0;
     // the gap closes at the step's fraction `phase`: δ_0 = −(1 − phase)·u0·dt
     let (mut delta, mut u, mut a) = (-(1.0 - phase) * u0 * dt, u0, 0.0);
-    let mut touched = false;
+    let (mut steps_in_contact, mut delta_max) = (0u64, 0.0f64);
     for _ in 0..1_000_000 {
         let half = u + 0.5 * dt * a;
         delta += half * dt;
         a = if delta > 0.0 {
-            -(s.k * delta + s.gamma * half) / meff
+            let f = s.k * delta + s.gamma * half;
+            -(if clip { f.max(0.0) } else { f }) / meff
         } else {
             0.0
         };
         u = half + 0.5 * dt * a;
-        touched |= delta > 0.0;
-        if touched && delta <= 0.0 && u < 0.0 {
-            return Some(-u / u0);
+        if delta > 0.0 {
+            steps_in_contact += 1;
+            delta_max = delta_max.max(delta);
+        }
+        if steps_in_contact > 0 && delta <= 0.0 && u < 0.0 {
+            return Some(DiscreteCollision {
+                e: -u / u0,
+                steps_in_contact,
+                delta_max_per_speed: delta_max / u0,
+            });
         }
         if !u.is_finite() {
             return None;
         }
     }
     None
+}
+
+/// The restitution coefficient of [`discrete_collision`] with the attractive tail kept
+/// (verdem's default law).
+pub fn discrete_restitution(meff: f64, s: Spring, dt: f64, phase: f64) -> Option<f64> {
+    discrete_collision(meff, s, dt, phase, false).map(|c| c.e)
 }
 
 /// The largest relative error |e_dt − e|/e (dimensionless) of the restitution coefficient of one

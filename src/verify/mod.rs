@@ -12,6 +12,7 @@
 pub mod collision;
 pub mod conservation;
 pub mod extremes;
+pub mod mcnamara;
 pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
@@ -62,6 +63,7 @@ pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
     let pair = load("objectivity.toml")?;
     rows.extend(objectivity::rows(&pair)?);
     rows.extend(ratchet::rows(&pair)?);
+    rows.extend(mcnamara::rows(&pair)?);
     rows.extend(conservation::rows(&load("conservation.toml")?, 1_000_000)?);
     Ok(rows)
 }

@@ -53,9 +53,32 @@ fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64
     Ok((-u1 / u0, (v[0].z - vt).abs() / (v[0].x - vn).abs()))
 }
 
+/// Relative tolerance of Jt/Jn = μ: the contact sticks in its first and last steps, where the
+/// spring has not reached the cap, an O(dt) shortfall of measured ≤ 1.9e-5 at tc/50; 5 times
+/// that, below the 1e-3 of a law whose μ is 0.1 % off.
+const MU_TOLERANCE: f64 = 1e-4;
+
+/// Absolute tolerance of β = e while sticking: the scheme's first-order error in e (8e-4 at
+/// tc/50, free–wall) plus the effect of the lever arm R − δ/2 and of the wall sphere's
+/// curvature on the tangential oscillator, O(δmax/R) = 3e-3; measured ≤ 1.8e-3.
+const STICK_TOLERANCE: f64 = 4e-3;
+
+/// Absolute tolerance of β = 7μ(1 + e)/(2ψ) − 1 while sliding: the first-order error of the
+/// clipped e (1.8e-4 relative at tc/50) and the sticking first and last steps; measured
+/// ≤ 4.5e-4.
+const SLIDE_TOLERANCE: f64 = 2e-3;
+
 /// The oblique-impact rows of every tangential convention for the case `base` (whose law must
 /// have kt/kn = γt/γn = 2/7).
 pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+    rows_against(base, base)
+}
+
+/// The oblique-impact rows of `simulated`'s law (any tangential convention replaced by each
+/// in turn) judged against the answers for `reference`'s law: with a law off by a small error,
+/// the rows that must catch it.
+pub fn rows_against(reference: &Case, simulated: &Case) -> anyhow::Result<Vec<Row>> {
+    let base = reference;
     let c = &base.contact;
     anyhow::ensure!(
         (c.kt / c.kn - 2.0 / 7.0).abs() < 1e-9 && (c.gammat / c.gamman - 2.0 / 7.0).abs() < 1e-9,
@@ -67,7 +90,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let mu = c.mu;
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
-        let mut unclipped = base.clone();
+        let mut unclipped = simulated.clone();
         unclipped.contact.tangential = conv;
         unclipped.contact.clip_normal = false;
         let mut clipped = unclipped.clone();
@@ -83,7 +106,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
                     "tangential restitution beta = e",
                     cf.e,
                     beta,
-                    1e-2,
+                    STICK_TOLERANCE,
                 );
                 // A cap on the spring alone, without the dashpot while sliding (LIGGGHTS):
                 // near the end of the contact, where Fn (with its dashpot) vanishes before δ,
@@ -93,13 +116,19 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             } else if psi >= 3.5 * mu * (1.0 + cf.e_clipped) {
                 let (beta, ratio) = on_wall(&clipped, vn, vt, 0.0)?;
                 let case = format!("oblique {name} {deg}deg psi={psi:.3} slide clipped");
-                rows.push(row(&case, "impulse ratio Jt/Jn = mu", mu, ratio, 1e-3));
+                rows.push(row(
+                    &case,
+                    "impulse ratio Jt/Jn = mu",
+                    mu,
+                    ratio,
+                    MU_TOLERANCE,
+                ));
                 rows.push(row_abs(
                     &case,
                     "beta = 7mu(1+e)/(2psi) - 1",
                     3.5 * mu * (1.0 + cf.e_clipped) / psi - 1.0,
                     beta,
-                    1e-2,
+                    SLIDE_TOLERANCE,
                 ));
             }
         }
@@ -110,7 +139,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             "tangential restitution beta = e",
             cf.e,
             beta,
-            1e-2,
+            STICK_TOLERANCE,
         ));
         let (_, ratio) = on_wall(&clipped, 1.0, 0.0, 3.0)?;
         rows.push(row(
@@ -118,7 +147,7 @@ pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
             "impulse ratio Jt/Jn = mu",
             mu,
             ratio,
-            1e-3,
+            MU_TOLERANCE,
         ));
         rows.extend(opposite_spins(&unclipped)?);
     }
@@ -147,6 +176,7 @@ fn opposite_spins(case: &Case) -> anyhow::Result<Vec<Row>> {
         .norm()
         .max((out.w[1] - Vec3::new(0.0, 0.0, -10.0)).norm());
     let name = format!("opposite spins {}", case.contact.tangential.name());
+    // mirror images: every tangential force and torque cancels exactly (measured 0)
     Ok(vec![
         row_abs(&name, "final tangential speed = 0", 0.0, tangential, 1e-12),
         row_abs(&name, "spin change = 0", 0.0, spin_change, 1e-10),
