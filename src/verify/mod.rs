@@ -82,8 +82,9 @@ pub struct Subject<'a> {
     pub tangential: Tangential,
     /// What it promises: the rows of the promises it does not make are documentation.
     pub properties: Properties,
-    /// Whose rows decide which of its rows gate: a row gates exactly when verdem's law of
-    /// this convention passes it (a program that claims to implement that convention).
+    /// The convention it claims to implement: where verdem's law of that convention misses a
+    /// row's expected value (a documented defect), the subject is held to verdem's number
+    /// instead, with the same tolerance.
     pub gated_as: Option<Tangential>,
     pub driver: &'a dyn MotionDriver,
 }
@@ -103,9 +104,9 @@ impl Subject<'static> {
 
 impl<'a> Subject<'a> {
     /// An external program behind `driver`. Claiming the convention `claim`, it runs the
-    /// case with `tangential = claim` and its rows gate where verdem's law of that convention
-    /// passes them; claiming none, it runs the case file's convention and every row gates
-    /// (the promises of an objective law).
+    /// case with `tangential = claim` and is held to verdem's numbers of that convention on
+    /// the rows that convention fails; claiming none, it runs the objective convention and
+    /// every row gates against its expected value (the promises of an objective law).
     pub fn code(driver: &'a dyn MotionDriver, claim: Option<Tangential>) -> Subject<'a> {
         Subject {
             label: format!("code:{}", driver.name()),
@@ -161,15 +162,35 @@ pub const MOTION_CASES: [MotionCase; 3] = [
 ];
 
 impl MotionCase {
-    /// The rows of `variant` for `subject`, with the gates of verdem's convention when the
-    /// subject is gated as one.
+    /// The rows of `variant` for `subject`, every one gating; a subject gated as a convention
+    /// is held to verdem's number of that convention where that convention misses the
+    /// expected value (the quantity then ends in `= verdem NAME`).
     pub fn judge(&self, dir: &Path, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
         let base = Case::load(&dir.join(self.file))?;
         let mut rows = (self.rows)(&base, subject, variant)?;
         if let Some(conv) = subject.gated_as {
             let own = (self.rows)(&base, &Subject::own(conv), variant)?;
             for (r, o) in rows.iter_mut().zip(&own) {
-                r.gate = o.passed();
+                *r = if o.passed() {
+                    Verdict {
+                        gate: true,
+                        ..r.clone()
+                    }
+                } else {
+                    let limit = match o.limit {
+                        Limit::Relative { tolerance, .. } => Limit::Relative {
+                            expected: o.measured,
+                            tolerance,
+                        },
+                        Limit::Absolute { tolerance, .. } => Limit::Absolute {
+                            expected: o.measured,
+                            tolerance,
+                        },
+                        other => other,
+                    };
+                    let quantity = format!("{} = verdem {}", r.quantity, conv.name());
+                    Verdict::judge(&r.case, &quantity, r.measured, limit)
+                };
             }
         }
         Ok(rows)
@@ -265,7 +286,7 @@ pub fn select<'a>(entries: Vec<Entry<'a>>, only: Option<&str>) -> anyhow::Result
     let chosen: Vec<Entry> = entries.into_iter().filter(|e| e.selected(only)).collect();
     if chosen.is_empty() {
         anyhow::bail!(
-            "--only {only:?}: no verification case's name contains it; the cases are:\n  {}",
+            "--only {only:?}: no verification row's case contains it; the cases are:\n  {}",
             names.join("\n  ")
         );
     }
@@ -294,13 +315,13 @@ pub use crate::analysis::verdict::failures;
 /// that documents a peer convention's known defect reads `FAIL*`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
-        "{:<56} {:<40} {:>13} {:>13} {:>13}  result\n",
+        "{:<56} {:<48} {:>13} {:>13} {:>13}  result\n",
         "case", "quantity", "expected", "measured", "tolerance"
     );
     for r in rows {
         if is_error(r) {
             s.push_str(&format!(
-                "{:<56} {:<40} {:>55}  ERROR\n",
+                "{:<56} {:<48} {:>55}  ERROR\n",
                 r.case, r.quantity, ""
             ));
             for line in r.measured_text.lines() {
@@ -314,7 +335,7 @@ pub fn table(rows: &[Row]) -> String {
             _ => String::new(),
         };
         s.push_str(&format!(
-            "{:<56} {:<40} {:>13.6e} {:>13.6e} {:>13}  {}\n",
+            "{:<56} {:<48} {:>13.6e} {:>13.6e} {:>13}  {}\n",
             r.case,
             r.quantity,
             r.limit.expected(),

@@ -24,7 +24,7 @@ use crate::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`,
-/// starting from the last row.
+/// starting from the last row; sphere 1 and both spins are still.
 fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f64) {
     let from = *rows.last().expect("a starting row");
     let axis = Unit::new_normalize(axis);
@@ -34,7 +34,8 @@ fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f6
         let mut row = from;
         row.t = from.t + k as f64 * dt;
         row.x[1] = from.x[0] + q * (from.x[1] - from.x[0]);
-        row.v[1] = omega.cross(&(row.x[1] - from.x[0]));
+        row.v = [Vec3::zeros(), omega.cross(&(row.x[1] - from.x[0]))];
+        row.w = [Vec3::zeros(); 2];
         rows.push(row);
     }
 }
