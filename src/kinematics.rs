@@ -483,6 +483,51 @@ mod tests {
     }
 
     #[test]
+    fn forces_csv_round_trips_and_errors_name_line_and_column() {
+        let case = Case::parse(include_str!("../cases/verify/objectivity.toml"), "o.toml").unwrap();
+        let mut rows = vec![still(0.0, 1e-3)];
+        rows.push(MotionRow {
+            t: 1e-4,
+            w: [Vec3::zeros(), Vec3::new(0.0, 0.3, 0.0)],
+            ..still(1e-4, 1e-3)
+        });
+        let f = drive(
+            law_of(&case).as_ref(),
+            [0.5, 0.5],
+            &rows,
+            Increment::Trapezoid,
+        );
+        let text = forces_csv(&f);
+        let read: Vec<ForceRow> = parse_forces_lines("f.csv", &text)
+            .unwrap()
+            .into_iter()
+            .map(|(_, r)| r)
+            .collect();
+        assert_eq!(read, f);
+        assert!(f[1].ft > 0.0 && f[1].torque[1] != Vec3::zeros());
+
+        let e = parse_forces_lines("f.csv", &text.replacen(",fn,", ",f_n,", 1))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("f.csv:1: header must be `t,fx1"), "{e}");
+        let with_field = |k: usize, value: &str| {
+            let mut lines: Vec<String> = text.lines().map(String::from).collect();
+            let mut fields: Vec<&str> = lines[2].split(',').collect();
+            fields[k] = value;
+            lines[2] = fields.join(",");
+            lines.join("\n")
+        };
+        let e = parse_forces_lines("f.csv", &with_field(1, "inf"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "f.csv:3: fx1: not a finite number: \"inf\"");
+        let e = parse_forces_lines("f.csv", &with_field(15, "1,2"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "f.csv:3: expected 16 columns, got 17");
+    }
+
+    #[test]
     fn static_overlap_gives_kn_delta_on_sphere_2_along_n_and_nothing_apart() {
         let case = Case::parse(
             include_str!("../cases/verify/binary_collision.toml"),

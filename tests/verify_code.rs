@@ -97,23 +97,28 @@ fn verdem_kinematics_as_a_program_passes_every_row_with_verdems_own_numbers() {
 fn the_command_line_prints_the_programs_rows_and_says_what_it_skipped() {
     let out = tempfile::tempdir().unwrap();
     let cmd = format!(
-        "{} kinematics --increment trapezoid",
+        "{} kinematics --increment positions",
         env!("CARGO_BIN_EXE_verdem")
     );
-    let run = common::verdem_ok([
-        "verify".as_ref(),
-        "--cases".as_ref(),
-        cases().as_os_str(),
-        "--code".as_ref(),
-        cmd.as_ref(),
-        "--code-name".as_ref(),
-        "positions".as_ref(),
-        "--only".as_ref(),
-        "ratchet".as_ref(),
-        "--out".as_ref(),
-        out.path().as_os_str(),
-    ]);
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args([
+            "verify",
+            "--code",
+            &cmd,
+            "--code-name",
+            "positions",
+            "--only",
+            "ratchet",
+        ])
+        .arg("--cases")
+        .arg(cases())
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .unwrap();
     let text = String::from_utf8_lossy(&run.stdout);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{text}{err}");
     assert!(text.contains("not run (they need a full solver)"), "{text}");
     let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("ratchet")).collect();
     assert_eq!(rows.len(), 4, "{text}");

@@ -235,11 +235,17 @@ impl<'a> Entry<'a> {
 /// run yet.
 pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
     let load = move |name: &str| Case::load(&dir.join(name));
+    // the beginnings of the rows' case names, per convention where a case has one
+    let per_convention = |kinds: &[&str]| -> Vec<String> {
+        let each = Tangential::ALL.into_iter().map(|c| c.name());
+        each.flat_map(|c| kinds.iter().map(move |k| format!("{k} {c}")))
+            .collect()
+    };
     let mut list = vec![
         Entry::new(["free-free", "free-wall"], move || {
             binary_collisions(&load("binary_collision.toml")?)
         }),
-        Entry::new(["oblique", "opposite spins"], move || {
+        Entry::new(per_convention(&["oblique", "opposite spins"]), move || {
             oblique::rows(&load("oblique_impact.toml")?)
         }),
     ];
@@ -252,7 +258,9 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
             }
         }
     }
-    list.push(Entry::new(["conservation"], move || {
+    let conservation = ["conservation gas".to_string()].into_iter();
+    let clusters = per_convention(&["conservation cluster"]);
+    list.push(Entry::new(conservation.chain(clusters), move || {
         conservation::rows(&load("conservation.toml")?, 1_000_000)
     }));
     list
