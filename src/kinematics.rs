@@ -233,20 +233,78 @@ fn blank_or_comment(record: &csv::StringRecord) -> bool {
     record.iter().eq([""]) || record[0].starts_with('#')
 }
 
-/// A record that is not a row of 27 finite numbers: the message names the column.
-fn bad_row(record: &csv::StringRecord, e: csv::Error) -> String {
+/// A record that is not a row of finite numbers: the message names the column.
+fn bad_row(columns: &[&str], record: &csv::StringRecord, e: csv::Error) -> String {
     let field = match e.kind() {
         csv::ErrorKind::Deserialize { err, .. } => err.field(),
         _ => None,
     };
     match field.map(|c| c as usize) {
-        Some(c) if c < MOTION_COLUMNS.len() => format!(
+        Some(c) if c < columns.len() => format!(
             "{}: not a finite number: {:?}",
-            MOTION_COLUMNS[c],
+            columns[c],
             record.get(c).unwrap_or_default()
         ),
         _ => e.to_string(),
     }
+}
+
+/// The rows of a CSV table of finite numbers with the header `columns` (`#` comments and
+/// blank lines skipped), each with its line; missing or extra columns, non-numbers and
+/// non-finite numbers are errors naming the file, line and column.
+fn numeric_rows<const N: usize>(
+    file: &str,
+    text: &str,
+    columns: &[&str; N],
+) -> Result<Vec<(usize, [f64; N])>, FormatError> {
+    let mut records = crate::io::csv_table::records(file, text, true);
+    let (hline, header) = records
+        .find(|r| r.as_ref().map_or(true, |(_, h)| !blank_or_comment(h)))
+        .transpose()?
+        .ok_or_else(|| err(file, 1, "empty: expected a header line".into()))?;
+    if header.iter().ne(columns.iter().copied()) {
+        return Err(err(
+            file,
+            hline,
+            format!(
+                "header must be `{}`, got `{}`",
+                columns.join(","),
+                text.lines()
+                    .nth(hline.saturating_sub(1))
+                    .unwrap_or_default()
+                    .trim()
+            ),
+        ));
+    }
+    let mut rows = Vec::new();
+    for record in records {
+        let (line, record) = record?;
+        if blank_or_comment(&record) {
+            continue;
+        }
+        if record.len() != N {
+            return Err(err(
+                file,
+                line,
+                format!("expected {N} columns, got {}", record.len()),
+            ));
+        }
+        let v: Vec<f64> = record
+            .deserialize(None)
+            .map_err(|e| err(file, line, bad_row(columns, &record, e)))?;
+        let v: [f64; N] = v
+            .try_into()
+            .map_err(|_| err(file, line, format!("expected {N} numbers")))?;
+        if let Some(c) = v.iter().position(|x| !x.is_finite()) {
+            return Err(err(
+                file,
+                line,
+                format!("{}: not a finite number: {:?}", columns[c], &record[c]),
+            ));
+        }
+        rows.push((line, v));
+    }
+    Ok(rows)
 }
 
 /// Parses a motion CSV (header line with [`MOTION_COLUMNS`], `#` comments allowed). Rejects
@@ -261,51 +319,8 @@ pub fn parse_motion(file: &str, text: &str) -> Result<Vec<MotionRow>, FormatErro
 
 /// As [`parse_motion`], with the line of each row.
 pub fn parse_motion_lines(file: &str, text: &str) -> Result<Vec<(usize, MotionRow)>, FormatError> {
-    let mut records = crate::io::csv_table::records(file, text, true);
-    let (hline, header) = records
-        .find(|r| r.as_ref().map_or(true, |(_, h)| !blank_or_comment(h)))
-        .transpose()?
-        .ok_or_else(|| err(file, 1, "empty: expected a header line".into()))?;
-    if header.iter().ne(MOTION_COLUMNS) {
-        return Err(err(
-            file,
-            hline,
-            format!(
-                "header must be `{}`, got `{}`",
-                MOTION_COLUMNS.join(","),
-                text.lines()
-                    .nth(hline.saturating_sub(1))
-                    .unwrap_or_default()
-                    .trim()
-            ),
-        ));
-    }
     let mut rows: Vec<(usize, MotionRow)> = Vec::new();
-    for record in records {
-        let (line, record) = record?;
-        if blank_or_comment(&record) {
-            continue;
-        }
-        if record.len() != 27 {
-            return Err(err(
-                file,
-                line,
-                format!("expected 27 columns, got {}", record.len()),
-            ));
-        }
-        let v: [f64; 27] = record
-            .deserialize(None)
-            .map_err(|e| err(file, line, bad_row(&record, e)))?;
-        if let Some(c) = v.iter().position(|x| !x.is_finite()) {
-            return Err(err(
-                file,
-                line,
-                format!(
-                    "{}: not a finite number: {:?}",
-                    MOTION_COLUMNS[c], &record[c]
-                ),
-            ));
-        }
+    for (line, v) in numeric_rows(file, text, &MOTION_COLUMNS)? {
         let sphere = |o: usize| -> Result<(Vec3, UnitQuaternion<f64>, Vec3, Vec3), FormatError> {
             let q = Quaternion::new(v[o + 3], v[o + 4], v[o + 5], v[o + 6]);
             if (q.norm() - 1.0).abs() > 1e-6 {
@@ -350,6 +365,27 @@ pub fn parse_motion_lines(file: &str, text: &str) -> Result<Vec<(usize, MotionRo
         ));
     }
     Ok(rows)
+}
+
+/// Parses a forces CSV (header line with [`FORCE_COLUMNS`], `#` comments allowed), each row
+/// with its line. Rejects missing or extra columns, non-numbers and non-finite numbers,
+/// naming the file, line and column.
+pub fn parse_forces_lines(file: &str, text: &str) -> Result<Vec<(usize, ForceRow)>, FormatError> {
+    Ok(numeric_rows(file, text, &FORCE_COLUMNS)?
+        .into_iter()
+        .map(|(line, v)| {
+            let vec = |o: usize| Vec3::new(v[o], v[o + 1], v[o + 2]);
+            let row = ForceRow {
+                t: v[0],
+                f: [vec(1), vec(7)],
+                torque: [vec(4), vec(10)],
+                delta: v[13],
+                fn_signed: v[14],
+                ft: v[15],
+            };
+            (line, row)
+        })
+        .collect())
 }
 
 /// A motion CSV of `rows` (round-trips bit for bit through [`parse_motion`]).
@@ -444,6 +480,51 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("quaternion norm 2 is not 1"), "{e}");
+    }
+
+    #[test]
+    fn forces_csv_round_trips_and_errors_name_line_and_column() {
+        let case = Case::parse(include_str!("../cases/verify/objectivity.toml"), "o.toml").unwrap();
+        let mut rows = vec![still(0.0, 1e-3)];
+        rows.push(MotionRow {
+            t: 1e-4,
+            w: [Vec3::zeros(), Vec3::new(0.0, 0.3, 0.0)],
+            ..still(1e-4, 1e-3)
+        });
+        let f = drive(
+            law_of(&case).as_ref(),
+            [0.5, 0.5],
+            &rows,
+            Increment::Trapezoid,
+        );
+        let text = forces_csv(&f);
+        let read: Vec<ForceRow> = parse_forces_lines("f.csv", &text)
+            .unwrap()
+            .into_iter()
+            .map(|(_, r)| r)
+            .collect();
+        assert_eq!(read, f);
+        assert!(f[1].ft > 0.0 && f[1].torque[1] != Vec3::zeros());
+
+        let e = parse_forces_lines("f.csv", &text.replacen(",fn,", ",f_n,", 1))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("f.csv:1: header must be `t,fx1"), "{e}");
+        let with_field = |k: usize, value: &str| {
+            let mut lines: Vec<String> = text.lines().map(String::from).collect();
+            let mut fields: Vec<&str> = lines[2].split(',').collect();
+            fields[k] = value;
+            lines[2] = fields.join(",");
+            lines.join("\n")
+        };
+        let e = parse_forces_lines("f.csv", &with_field(1, "inf"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "f.csv:3: fx1: not a finite number: \"inf\"");
+        let e = parse_forces_lines("f.csv", &with_field(15, "1,2"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "f.csv:3: expected 16 columns, got 17");
     }
 
     #[test]

@@ -1,12 +1,15 @@
 //! `verdem verify`: run the verification cases (and the peers' binary collisions) and print
-//! expected, measured, tolerance and PASS/FAIL.
+//! expected, measured, tolerance and PASS/FAIL; with `--code`, run the prescribed-motion cases
+//! through an external program instead.
 
 use std::path::PathBuf;
 
-use verdem::case::Case;
+use verdem::case::{Case, Tangential};
 use verdem::peers::{self, Peer};
-use verdem::verify;
+use verdem::verify::driver::External;
+use verdem::verify::{self, Subject};
 
+use super::args::described;
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -14,7 +17,8 @@ pub struct Args {
     /// The folder of the verification cases.
     #[arg(long, default_value = "cases/verify")]
     cases: PathBuf,
-    /// Only the rows whose case name contains this text.
+    /// Only the cases whose name contains this text (or that it begins with): the others
+    /// are not run.
     #[arg(long)]
     only: Option<String>,
     /// Also run the binary collisions in these installed peers (lammps, liggghts, yade,
@@ -22,20 +26,63 @@ pub struct Args {
     /// the same closed forms.
     #[arg(long, value_parser = peers::by_name, value_delimiter = ',')]
     peers: Vec<&'static dyn Peer>,
-    /// Where the peers' collision runs go.
+    /// Run the prescribed-motion cases (objectivity, ratchet, tangential histories) through
+    /// this program instead of verdem's laws: it is run as `CMD CASE.toml MOTION.csv --out
+    /// FORCES.csv`, like `verdem kinematics` (docs/code-interface.md).
+    #[arg(long, value_name = "CMD")]
+    code: Option<String>,
+    /// The program's name in the table (default: the file name of its script or program).
+    #[arg(long, requires = "code")]
+    code_name: Option<String>,
+    /// The verdem convention the program implements: the case it gets names it, and its
+    /// rows gate where verdem's law of that convention passes them (without it, every row
+    /// gates: the promises of an objective law).
+    #[arg(
+        long,
+        requires = "code",
+        value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
+    )]
+    convention: Option<Tangential>,
+    /// Where the peers' collision runs and the program's files go.
     #[arg(long, default_value = "out/verify")]
     out: PathBuf,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let mut rows = verify::all(&a.cases)?;
+    let only = a.only.as_deref();
+    let mut rows = match &a.code {
+        Some(cmd) => {
+            let name = a
+                .code_name
+                .clone()
+                .unwrap_or_else(|| External::default_name(cmd));
+            let program = External::new(cmd, &name, &a.out.join("code"));
+            let subject = Subject::code(&program, a.convention);
+            let entries = verify::select(verify::code_entries(&a.cases, &subject), only)?;
+            let rows = verify::run(&entries)?;
+            println!(
+                "{}: the prescribed-motion cases through `{cmd}`, {}; not run (they need a full \
+                 solver): binary collisions, oblique impacts, conservation",
+                subject.label,
+                match a.convention {
+                    Some(c) => format!(
+                        "gated as verdem's `{}` (rows that convention fails read FAIL*)",
+                        c.name()
+                    ),
+                    None => "every row gating".into(),
+                }
+            );
+            rows
+        }
+        None => verify::run(&verify::select(verify::entries(&a.cases), only)?)?,
+    };
     let collision = Case::load(&a.cases.join("binary_collision.toml"))?;
     for peer in a.peers {
         let dir = a.out.join(peer.binary());
         rows.extend(peers::collision::rows(peer, &collision, &dir)?);
     }
-    if let Some(only) = a.only {
-        rows.retain(|r| r.case.contains(&only));
+    if let Some(only) = only {
+        rows.retain(|r| r.case.contains(only));
         if rows.is_empty() {
             anyhow::bail!("--only {only:?}: no verification row's case contains it");
         }
@@ -43,8 +90,14 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     print!("{}", verify::table(&rows));
     let passed = rows.iter().filter(|r| r.passed()).count();
     let failed = verify::failures(&rows);
+    let errors = rows.iter().filter(|r| verify::is_error(r)).count();
     println!(
-        "{passed} passed, {failed} failed, {} known defects of peer conventions (FAIL*)",
+        "{passed} passed, {failed} failed{}, {} known defects of peer conventions (FAIL*)",
+        if errors > 0 {
+            format!(" ({errors} could not be measured: ERROR)")
+        } else {
+            String::new()
+        },
         rows.len() - passed - failed
     );
     Ok(if failed > 0 {

@@ -4,14 +4,22 @@
 //! - [`collision`]: binary normal collisions against the closed forms (clipped and not);
 //! - [`oblique`]: oblique impacts, the sticking and sliding regimes of the linear spring and
 //!   Coulomb slider (Walton; Chung & Ooi 2011), per tangential convention;
-//! - [`objectivity`]: a loaded contact rotated rigidly, per convention (kinematics driver);
+//! - [`objectivity`]: a loaded contact rotated rigidly, per convention;
 //! - [`ratchet`]: closed cycles of relative motion below the sliding limit (McNamara et al.
-//!   2008), per convention (kinematics driver);
+//!   2008), per convention;
+//! - [`histories`]: the tangential spring loaded and unloaded, taken to the Coulomb limit and
+//!   back, and reset when the contact opens, per convention;
 //! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster.
+//!
+//! The table is a list of named [`Entry`]s, selected by name before any of them runs. The
+//! prescribed-motion cases (objectivity, ratchet, histories) drive their contact through a
+//! [`driver::MotionDriver`]: verdem's own law, or an external program ([`code_entries`]).
 
 pub mod collision;
 pub mod conservation;
+pub mod driver;
 pub mod extremes;
+pub mod histories;
 pub mod mcnamara;
 pub mod objectivity;
 pub mod oblique;
@@ -19,9 +27,12 @@ pub mod ratchet;
 
 use std::path::Path;
 
+use crate::analysis::verdict::Outcome;
 use crate::analysis::{Limit, Verdict};
-use crate::case::Case;
+use crate::case::{Case, Tangential};
+use crate::contact::registry::Properties;
 pub use collision::{binary_collisions, closed_form, collide, ClosedForm, Measured};
+use driver::{MotionDriver, OWN};
 
 /// One line of the verification table: a case's quantity judged against its expected value
 /// with a relative ([`row`]) or absolute ([`row_abs`]) tolerance.
@@ -53,19 +64,260 @@ pub fn row_abs(case: &str, quantity: &str, expected: f64, measured: f64, toleran
     )
 }
 
+/// A row saying that a case could not be measured: `error` in words, failing and gating.
+pub fn error_row(case: &str, error: &anyhow::Error) -> Row {
+    Verdict::judge(case, "could not be measured", f64::NAN, Limit::None)
+        .described(format!("{error:#}"), String::new())
+}
+
+/// Whether `r` is an [`error_row`].
+pub fn is_error(r: &Row) -> bool {
+    r.limit == Limit::None && r.outcome == Outcome::Fail
+}
+
+/// Who drives a prescribed-motion case and what it is held to.
+pub struct Subject<'a> {
+    /// Its name in the case column: a convention's name, or `code:NAME` for a program.
+    pub label: String,
+    /// The tangential convention written into the case it drives.
+    pub tangential: Tangential,
+    /// What it promises: the rows of the promises it does not make are documentation.
+    pub properties: Properties,
+    /// The convention it claims to implement: where verdem's law of that convention misses a
+    /// row's expected value (a documented defect), the subject is held to verdem's number
+    /// instead, with the same tolerance.
+    pub gated_as: Option<Tangential>,
+    pub driver: &'a dyn MotionDriver,
+}
+
+impl Subject<'static> {
+    /// verdem's own law in the convention `conv`, held to the promises of its properties.
+    pub fn own(conv: Tangential) -> Subject<'static> {
+        Subject {
+            label: conv.name().into(),
+            tangential: conv,
+            properties: conv.properties(),
+            gated_as: None,
+            driver: &OWN,
+        }
+    }
+}
+
+impl<'a> Subject<'a> {
+    /// An external program behind `driver`. Claiming the convention `claim`, it runs the
+    /// case with `tangential = claim` and is held to verdem's numbers of that convention on
+    /// the rows that convention fails; claiming none, it runs the objective convention and
+    /// every row gates against its expected value (the promises of an objective law).
+    pub fn code(driver: &'a dyn MotionDriver, claim: Option<Tangential>) -> Subject<'a> {
+        Subject {
+            label: format!("code:{}", driver.name()),
+            tangential: claim.unwrap_or(Tangential::Objective),
+            properties: claim.unwrap_or(Tangential::Objective).properties(),
+            gated_as: claim,
+            driver,
+        }
+    }
+
+    /// `base` with this subject's tangential convention.
+    pub fn case(&self, base: &Case) -> Case {
+        let mut case = base.clone();
+        case.contact.tangential = self.tangential;
+        case
+    }
+}
+
+/// A case that drives one contact through a prescribed motion, in several variants (axes,
+/// rotations, histories).
+#[derive(Clone, Copy)]
+pub struct MotionCase {
+    /// Its case file in the verification folder.
+    pub file: &'static str,
+    /// Its variants' names.
+    pub variants: &'static [&'static str],
+    /// The name of a variant's case for a subject's label.
+    pub name: fn(&str, &str) -> String,
+    /// The rows of a variant for a subject.
+    pub rows: fn(&Case, &Subject, &str) -> anyhow::Result<Vec<Row>>,
+}
+
+/// Every prescribed-motion case, in the table's order.
+pub const MOTION_CASES: [MotionCase; 3] = [
+    MotionCase {
+        file: "objectivity.toml",
+        variants: &objectivity::AXES,
+        name: objectivity::case_name,
+        rows: objectivity::axis_rows,
+    },
+    MotionCase {
+        file: "objectivity.toml",
+        variants: &ratchet::ROTATIONS,
+        name: ratchet::case_name,
+        rows: ratchet::rotation_rows,
+    },
+    MotionCase {
+        file: "objectivity.toml",
+        variants: &histories::HISTORIES,
+        name: histories::case_name,
+        rows: histories::history_rows,
+    },
+];
+
+impl MotionCase {
+    /// The rows of `variant` for `subject`, every one gating; a subject gated as a convention
+    /// is held to verdem's number of that convention where that convention misses the
+    /// expected value (the quantity then ends in `= verdem NAME`).
+    pub fn judge(&self, dir: &Path, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
+        let base = Case::load(&dir.join(self.file))?;
+        let mut rows = (self.rows)(&base, subject, variant)?;
+        if let Some(conv) = subject.gated_as {
+            let own = (self.rows)(&base, &Subject::own(conv), variant)?;
+            for (r, o) in rows.iter_mut().zip(&own) {
+                *r = if o.passed() {
+                    Verdict {
+                        gate: true,
+                        ..r.clone()
+                    }
+                } else {
+                    let limit = match o.limit {
+                        Limit::Relative { tolerance, .. } => Limit::Relative {
+                            expected: o.measured,
+                            tolerance,
+                        },
+                        Limit::Absolute { tolerance, .. } => Limit::Absolute {
+                            expected: o.measured,
+                            tolerance,
+                        },
+                        other => other,
+                    };
+                    let quantity = format!("{} = verdem {}", r.quantity, conv.name());
+                    Verdict::judge(&r.case, &quantity, r.measured, limit)
+                };
+            }
+        }
+        Ok(rows)
+    }
+}
+
+/// One case of the verification table (or a group of cases run together), run only when
+/// selected.
+pub struct Entry<'a> {
+    /// The names of the cases its rows belong to, or their beginnings.
+    pub names: Vec<String>,
+    run: Box<dyn Fn() -> anyhow::Result<Vec<Row>> + 'a>,
+}
+
+impl<'a> Entry<'a> {
+    /// An entry named `names` whose rows `run` measures.
+    pub fn new<S: ToString>(
+        names: impl IntoIterator<Item = S>,
+        run: impl Fn() -> anyhow::Result<Vec<Row>> + 'a,
+    ) -> Entry<'a> {
+        Entry {
+            names: names.into_iter().map(|n| n.to_string()).collect(),
+            run: Box::new(run),
+        }
+    }
+
+    /// Whether `only` selects it: one of its names contains `only`, or `only` begins with one
+    /// of them (`free-wall v0=1` selects the entry `free-wall`).
+    pub fn selected(&self, only: &str) -> bool {
+        self.names
+            .iter()
+            .any(|n| n.contains(only) || only.starts_with(n.as_str()))
+    }
+
+    /// Measures its rows.
+    pub fn run(&self) -> anyhow::Result<Vec<Row>> {
+        (self.run)()
+    }
+}
+
+/// Every verification case of the folder `dir` (cases/verify), in the table's order, none
+/// run yet.
+pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
+    let load = move |name: &str| Case::load(&dir.join(name));
+    // the beginnings of the rows' case names, per convention where a case has one
+    let per_convention = |kinds: &[&str]| -> Vec<String> {
+        let each = Tangential::ALL.into_iter().map(|c| c.name());
+        each.flat_map(|c| kinds.iter().map(move |k| format!("{k} {c}")))
+            .collect()
+    };
+    let mut list = vec![
+        Entry::new(["free-free", "free-wall"], move || {
+            binary_collisions(&load("binary_collision.toml")?)
+        }),
+        Entry::new(per_convention(&["oblique", "opposite spins"]), move || {
+            oblique::rows(&load("oblique_impact.toml")?)
+        }),
+    ];
+    for case in MOTION_CASES {
+        for conv in Tangential::ALL {
+            for &variant in case.variants {
+                list.push(Entry::new([(case.name)(conv.name(), variant)], move || {
+                    case.judge(dir, &Subject::own(conv), variant)
+                }));
+            }
+        }
+    }
+    list.push(Entry::new(per_convention(&["mcnamara"]), move || {
+        mcnamara::rows(&load("objectivity.toml")?)
+    }));
+    let conservation = ["conservation gas".to_string()].into_iter();
+    let clusters = per_convention(&["conservation cluster"]);
+    list.push(Entry::new(conservation.chain(clusters), move || {
+        conservation::rows(&load("conservation.toml")?, 1_000_000)
+    }));
+    list
+}
+
+/// The prescribed-motion cases of the folder `dir` driven by the program `subject`: a case
+/// the program fails (does not start, exits non-zero, writes a malformed forces file) gives
+/// one [`error_row`] instead of its rows.
+pub fn code_entries<'a>(dir: &'a Path, subject: &'a Subject<'a>) -> Vec<Entry<'a>> {
+    let mut list = Vec::new();
+    for case in MOTION_CASES {
+        for &variant in case.variants {
+            let name = (case.name)(&subject.label, variant);
+            list.push(Entry::new([name.clone()], move || {
+                Ok(case
+                    .judge(dir, subject, variant)
+                    .unwrap_or_else(|e| vec![error_row(&name, &e)]))
+            }));
+        }
+    }
+    list
+}
+
+/// The entries `only` selects (all of them without it); an error listing every name when it
+/// selects none.
+pub fn select<'a>(entries: Vec<Entry<'a>>, only: Option<&str>) -> anyhow::Result<Vec<Entry<'a>>> {
+    let Some(only) = only else {
+        return Ok(entries);
+    };
+    let names: Vec<String> = entries.iter().flat_map(|e| e.names.clone()).collect();
+    let chosen: Vec<Entry> = entries.into_iter().filter(|e| e.selected(only)).collect();
+    if chosen.is_empty() {
+        anyhow::bail!(
+            "--only {only:?}: no verification row's case contains it; the cases are:\n  {}",
+            names.join("\n  ")
+        );
+    }
+    Ok(chosen)
+}
+
+/// The rows of `entries`, in order.
+pub fn run(entries: &[Entry]) -> anyhow::Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    for e in entries {
+        rows.extend(e.run()?);
+    }
+    Ok(rows)
+}
+
 /// Every verification case of the folder `dir` (cases/verify): the table `verdem verify`
 /// prints.
 pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
-    let load = |name: &str| Case::load(&dir.join(name));
-    let mut rows = binary_collisions(&load("binary_collision.toml")?)?;
-    rows.extend(oblique::rows(&load("oblique_impact.toml")?)?);
-    // one contact, driven by rigid rotations (objectivity) and by the ratcheting cycle
-    let pair = load("objectivity.toml")?;
-    rows.extend(objectivity::rows(&pair)?);
-    rows.extend(ratchet::rows(&pair)?);
-    rows.extend(mcnamara::rows(&pair)?);
-    rows.extend(conservation::rows(&load("conservation.toml")?, 1_000_000)?);
-    Ok(rows)
+    run(&entries(dir))
 }
 
 /// Rows that gate and failed.
@@ -75,17 +327,27 @@ pub use crate::analysis::verdict::failures;
 /// that documents a peer convention's known defect reads `FAIL*`.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
-        "{:<56} {:<40} {:>13} {:>13} {:>13}  result\n",
+        "{:<56} {:<48} {:>13} {:>13} {:>13}  result\n",
         "case", "quantity", "expected", "measured", "tolerance"
     );
     for r in rows {
+        if is_error(r) {
+            s.push_str(&format!(
+                "{:<56} {:<48} {:>55}  ERROR\n",
+                r.case, r.quantity, ""
+            ));
+            for line in r.measured_text.lines() {
+                s.push_str(&format!("    {line}\n"));
+            }
+            continue;
+        }
         let tol = match r.limit {
             Limit::Relative { tolerance, .. } => format!("{tolerance:.1e} rel"),
             Limit::Absolute { tolerance, .. } => format!("{tolerance:.1e} abs"),
             _ => String::new(),
         };
         s.push_str(&format!(
-            "{:<56} {:<40} {:>13.6e} {:>13.6e} {:>13}  {}\n",
+            "{:<56} {:<48} {:>13.6e} {:>13.6e} {:>13}  {}\n",
             r.case,
             r.quantity,
             r.limit.expected(),

@@ -1,5 +1,5 @@
 //! Objectivity of the tangential force under a rigid rotation of a loaded contact, per
-//! tangential convention, through the kinematics driver.
+//! tangential convention (or for an external program), through a [`MotionDriver`].
 //!
 //! Sphere 2 is spun about an axis of the tangent plane until the tangential spring carries
 //! about a fifth of mu·fn, held still, then the pair is rotated rigidly by 1 rad (positions,
@@ -12,9 +12,10 @@
 
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 
-use super::{row_abs, Row};
+use super::driver::MotionDriver;
+use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
+use crate::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Steps of the rigid rotation per radian.
@@ -72,8 +73,9 @@ pub fn tangential_force(f: &ForceRow, n: Vec3) -> Vec3 {
     f.f[1] - f.f[1].dot(&n) * n
 }
 
-/// Drifts per radian (Fn, |Ft|, direction of Ft) of `case`'s law rotated about `axis`.
-pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
+/// Drifts per radian (Fn, |Ft|, direction of Ft) of `case`'s contact, driven by `driver`,
+/// rotated about `axis`.
+pub fn drifts(case: &Case, axis: Vec3, driver: &dyn MotionDriver) -> anyhow::Result<[f64; 3]> {
     let (x, radius) = pair_of(case)?;
     let dt = case.dt();
     let start = MotionRow {
@@ -92,8 +94,7 @@ pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
     spin_sphere_2(&mut rows, tangent, load, 100, 10, dt);
     let loaded = rows.len() - 1;
     rigid_rotation(&mut rows, axis, 1.0, STEPS_PER_RADIAN, dt);
-    let law = law_of(case);
-    let f = drive(law.as_ref(), radius, &rows, Increment::Positions);
+    let f = driver.drive(case, &rows)?;
     let end = rows.len() - 1;
     let rot = Rotation3::from_axis_angle(&Unit::new_normalize(axis), 1.0);
     let n1 = rot * n0;
@@ -109,33 +110,45 @@ pub fn drifts(case: &Case, axis: Vec3) -> anyhow::Result<[f64; 3]> {
     ])
 }
 
-/// The objectivity rows of every tangential convention.
-pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+/// The rotation axes, by their names in the table.
+pub const AXES: [&str; 3] = ["tangent axis", "normal axis", "oblique axis"];
+
+/// The rotation axis named `label` (one of [`AXES`]) for the unit normal `n0`.
+fn axis(n0: Vec3, label: &str) -> Vec3 {
+    let in_plane = tangent_axis(n0);
+    match label {
+        "tangent axis" => in_plane,
+        "normal axis" => n0,
+        _ => (in_plane + n0 + in_plane.cross(&n0)).normalize(),
+    }
+}
+
+/// The name of the case rotating `subject`'s contact about the axis named `label`.
+pub fn case_name(subject: &str, label: &str) -> String {
+    format!("objectivity {subject} {label}")
+}
+
+/// The objectivity rows of `subject` rotated about the axis named `label` (one of [`AXES`]).
+pub fn axis_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Result<Vec<Row>> {
     let (x, _) = pair_of(base)?;
     let n0 = (x[1] - x[0]).normalize();
-    let in_plane = tangent_axis(n0);
+    let case = subject.case(base);
+    let [dfn, dft, dir] = drifts(&case, axis(n0, label), subject.driver)?;
+    let name = case_name(&subject.label, label);
+    let gate = |r: Row| r.gating_if(subject.properties.objective);
+    Ok(vec![
+        gate(row_abs(&name, "Fn drift per rad", 0.0, dfn, 1e-6)),
+        gate(row_abs(&name, "|Ft| drift per rad", 0.0, dft, 1e-6)),
+        gate(row_abs(&name, "Ft direction error per rad", 0.0, dir, 1e-6)),
+    ])
+}
+
+/// The objectivity rows of every tangential convention.
+pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
-        let mut case = base.clone();
-        case.contact.tangential = conv;
-        let oblique = (in_plane + n0 + in_plane.cross(&n0)).normalize();
-        for (label, axis) in [
-            ("tangent axis", in_plane),
-            ("normal axis", n0),
-            ("oblique axis", oblique),
-        ] {
-            let [dfn, dft, dir] = drifts(&case, axis)?;
-            let name = format!("objectivity {} {label}", conv.name());
-            let gate = |r: Row| r.gating_if(conv.properties().objective);
-            rows.push(gate(row_abs(&name, "Fn drift per rad", 0.0, dfn, 1e-6)));
-            rows.push(gate(row_abs(&name, "|Ft| drift per rad", 0.0, dft, 1e-6)));
-            rows.push(gate(row_abs(
-                &name,
-                "Ft direction error per rad",
-                0.0,
-                dir,
-                1e-6,
-            )));
+        for label in AXES {
+            rows.extend(axis_rows(base, &Subject::own(conv), label)?);
         }
     }
     Ok(rows)

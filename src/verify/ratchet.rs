@@ -1,5 +1,6 @@
 //! Ratcheting: closed cycles of relative motion below the sliding limit (McNamara, García-Rojo &
-//! Herrmann, PRE 77, 031304, 2008), per tangential convention, through the kinematics driver.
+//! Herrmann, PRE 77, 031304, 2008), per tangential convention (or for an external program),
+//! through a [`MotionDriver`].
 //!
 //! At constant overlap (constant normal load), with the dashpots switched off: (A) sphere 2
 //! translates around sphere 1 by an arc dx (an orbit at constant distance, loading the spring
@@ -15,14 +16,15 @@
 
 use nalgebra::{Unit, UnitQuaternion};
 
+use super::driver::MotionDriver;
 use super::objectivity::{rigid_rotation, tangent_axis};
-use super::{row_abs, Row};
+use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
+use crate::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`,
-/// starting from the last row.
+/// starting from the last row; sphere 1 and both spins are still.
 fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f64) {
     let from = *rows.last().expect("a starting row");
     let axis = Unit::new_normalize(axis);
@@ -32,7 +34,8 @@ fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f6
         let mut row = from;
         row.t = from.t + k as f64 * dt;
         row.x[1] = from.x[0] + q * (from.x[1] - from.x[0]);
-        row.v[1] = omega.cross(&(row.x[1] - from.x[0]));
+        row.v = [Vec3::zeros(), omega.cross(&(row.x[1] - from.x[0]))];
+        row.w = [Vec3::zeros(); 2];
         rows.push(row);
     }
 }
@@ -63,9 +66,16 @@ pub struct Cycle {
     pub work: f64,
 }
 
-/// One cycle with the pair rotated about `axis` by 1 rad, at the case's positions scaled to
-/// the overlap `overlap`, translating by the arc `dx`.
-pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<Cycle> {
+/// One cycle of `case`'s contact, driven by `driver`, with the pair rotated about `axis` by
+/// 0.1 rad, at the case's positions scaled to the overlap `overlap`, translating by the arc
+/// `dx`.
+pub fn cycle(
+    case: &Case,
+    axis: Vec3,
+    overlap: f64,
+    dx: f64,
+    driver: &dyn MotionDriver,
+) -> anyhow::Result<Cycle> {
     let (mut x, radius) = pair_of(case)?;
     let dt = case.dt();
     let n0 = (x[1] - x[0]).normalize();
@@ -85,8 +95,7 @@ pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<C
     let turned = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), a) * orbit_axis;
     orbit(&mut rows, turned, -theta, 2000, dt);
     rigid_rotation(&mut rows, axis, -a, 10_000, dt);
-    let law = law_of(case);
-    let f = drive(law.as_ref(), radius, &rows, Increment::Positions);
+    let f = driver.drive(case, &rows)?;
     Ok(Cycle {
         residual: f.last().map_or(0.0, |r| r.ft),
         peak: f.iter().map(|r| r.ft).fold(0.0, f64::max),
@@ -94,54 +103,66 @@ pub fn cycle(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<C
     })
 }
 
-/// The ratcheting rows of every tangential convention: at the case's overlap and at twice it.
-pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+/// The rotations of the cycle, by their names in the table.
+pub const ROTATIONS: [&str; 2] = ["rotation about n", "rotation about t"];
+
+/// The name of the cycle of `subject`'s contact with the rotation named `label`.
+pub fn case_name(subject: &str, label: &str) -> String {
+    format!("ratchet {subject} {label}")
+}
+
+/// The ratcheting rows of `subject` with the rotation named `label` (one of [`ROTATIONS`]):
+/// at the case's overlap and at twice it, dashpots off.
+pub fn rotation_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Result<Vec<Row>> {
     let (x, radius) = pair_of(base)?;
     let n0 = (x[1] - x[0]).normalize();
-    let tangent = tangent_axis(n0);
-    let along = tangent.cross(&n0);
+    let axis = match label {
+        "rotation about n" => n0,
+        _ => tangent_axis(n0).cross(&n0),
+    };
     let overlap = radius[0] + radius[1] - (x[1] - x[0]).norm();
     // loads the spring to half the sliding limit at the case's overlap
     let dx = 0.5 * base.contact.mu * base.contact.kn * overlap / base.contact.kt;
+    let mut case = subject.case(base);
+    case.contact.gamman = 0.0;
+    case.contact.gammat = 0.0;
+    let c = cycle(&case, axis, overlap, dx, subject.driver)?;
+    let energy = c.peak * c.peak / (2.0 * case.contact.kt);
+    let name = case_name(&subject.label, label);
+    let gate = |r: Row| r.gating_if(subject.properties.objective);
+    let (res, work) = (c.residual / c.peak, c.work / energy);
+    let mut rows = vec![
+        gate(row_abs(&name, "residual |Ft| / peak |Ft|", 0.0, res, 1e-6)),
+        gate(row_abs(
+            &name,
+            "net work / peak elastic energy",
+            0.0,
+            work,
+            1e-6,
+        )),
+    ];
+    // A spring that does not twist with the pair is left turned by the rotation's twist,
+    // ≈ a·cos θ, wherever the translations put it: a residual ≈ kt·dx·a, independent of the
+    // load.
+    if !subject.properties.twists_spring && label == "rotation about n" {
+        let twice = cycle(&case, axis, 2.0 * overlap, dx, subject.driver)?;
+        rows.push(row_abs(
+            &name,
+            "load exponent of the residual (fn x2)",
+            0.0,
+            (twice.residual / c.residual).log2(),
+            0.05,
+        ));
+    }
+    Ok(rows)
+}
+
+/// The ratcheting rows of every tangential convention.
+pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
-        let mut case = base.clone();
-        case.contact.tangential = conv;
-        case.contact.gamman = 0.0;
-        case.contact.gammat = 0.0;
-        for (label, axis) in [("rotation about n", n0), ("rotation about t", along)] {
-            let c = cycle(&case, axis, overlap, dx)?;
-            let twice = cycle(&case, axis, 2.0 * overlap, dx)?;
-            let energy = c.peak * c.peak / (2.0 * case.contact.kt);
-            let name = format!("ratchet {} {label}", conv.name());
-            let gate = |r: Row| r.gating_if(conv.properties().objective);
-            let (res, work) = (c.residual / c.peak, c.work / energy);
-            rows.push(gate(row_abs(
-                &name,
-                "residual |Ft| / peak |Ft|",
-                0.0,
-                res,
-                1e-6,
-            )));
-            rows.push(gate(row_abs(
-                &name,
-                "net work / peak elastic energy",
-                0.0,
-                work,
-                1e-6,
-            )));
-            // A spring that does not twist with the pair is left turned by the rotation's
-            // twist, ≈ a·cos θ, wherever the translations put it: a residual ≈ kt·dx·a,
-            // independent of the load.
-            if !conv.properties().twists_spring && label == "rotation about n" {
-                rows.push(row_abs(
-                    &name,
-                    "load exponent of the residual (fn x2)",
-                    0.0,
-                    (twice.residual / c.residual).log2(),
-                    0.05,
-                ));
-            }
+        for label in ROTATIONS {
+            rows.extend(rotation_rows(base, &Subject::own(conv), label)?);
         }
     }
     Ok(rows)

@@ -1,0 +1,319 @@
+//! `verdem verify --code`: the prescribed-motion cases run through an external program
+//! (tests/code/contact_law.py, MercuryDPM's law written independently in Python, with and
+//! without known defects; verdem's own `kinematics` command; broken programs) and judged in
+//! the same table.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use verdem::case::{Case, Tangential};
+use verdem::kinematics::{self, ForceRow, MotionRow};
+use verdem::verify::driver::{External, MotionDriver, OWN};
+use verdem::verify::{self, Row, Subject};
+
+fn cases() -> std::path::PathBuf {
+    common::root().join("cases/verify")
+}
+
+fn python() -> String {
+    std::env::var("VERDEM_PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+/// The command running tests/code/`script` with `args`.
+fn script(script: &str, args: &str) -> String {
+    let path = common::root().join("tests/code").join(script);
+    format!("{} {} {args}", python(), path.display())
+}
+
+/// Every prescribed-motion row of `driver`, gated as `claim` claims.
+fn code_rows(driver: &dyn MotionDriver, claim: Option<Tangential>) -> Vec<Row> {
+    let dir = cases();
+    let subject = Subject::code(driver, claim);
+    let entries = verify::code_entries(&dir, &subject);
+    verify::run(&entries).unwrap()
+}
+
+/// verdem's own prescribed-motion rows of the convention `conv`, in the table's order.
+fn own_rows(conv: Tangential) -> Vec<Row> {
+    let dir = cases();
+    let own = Subject::own(conv);
+    let mut rows = Vec::new();
+    for case in verify::MOTION_CASES {
+        for &variant in case.variants {
+            rows.extend(case.judge(&dir, &own, variant).unwrap());
+        }
+    }
+    rows
+}
+
+/// The rows of verdem's law read back through the motion file, as a program reading
+/// MOTION.csv sees the motion (quaternions renormalised).
+struct ReadBack;
+
+impl MotionDriver for ReadBack {
+    fn drive(&self, case: &Case, motion: &[MotionRow]) -> anyhow::Result<Vec<ForceRow>> {
+        let read = kinematics::parse_motion("m", &kinematics::motion_csv(motion))?;
+        OWN.drive(case, &read)
+    }
+    fn name(&self) -> String {
+        "verdem".into()
+    }
+}
+
+/// Case and quantity of the gating rows that failed.
+fn failed(rows: &[Row]) -> BTreeSet<(String, String)> {
+    rows.iter()
+        .filter(|r| r.gate && !r.passed())
+        .map(|r| (r.case.clone(), r.quantity.clone()))
+        .collect()
+}
+
+#[test]
+fn verdem_kinematics_as_a_program_passes_every_row_with_verdems_own_numbers() {
+    let scratch = tempfile::tempdir().unwrap();
+    let cmd = format!("{} kinematics", env!("CARGO_BIN_EXE_verdem"));
+    let program = External::new(&cmd, "verdem", scratch.path());
+    let rows = code_rows(&program, None);
+    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4);
+    assert!(rows.iter().all(|r| r.passed() && r.gate), "{rows:#?}");
+    // bit for bit the numbers of verdem's law driven through the motion the file holds
+    let read_back = code_rows(&ReadBack, None);
+    for (r, b) in rows.iter().zip(&read_back) {
+        assert_eq!(r.measured.to_bits(), b.measured.to_bits(), "{r:?} {b:?}");
+    }
+    // and those of the table's own objective rows, to the round-off of the renormalised
+    // quaternions (the angle between two nearly parallel vectors carries 1e-8 of it)
+    for (r, o) in rows.iter().zip(own_rows(Tangential::Objective)) {
+        assert_eq!(r.quantity, o.quantity);
+        assert!((r.measured - o.measured).abs() <= 1e-7, "{r:?} {o:?}");
+    }
+    // nothing is left behind by runs that succeeded
+    assert_eq!(std::fs::read_dir(scratch.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn the_command_line_prints_the_programs_rows_and_says_what_it_skipped() {
+    let out = tempfile::tempdir().unwrap();
+    let cmd = format!(
+        "{} kinematics --increment positions",
+        env!("CARGO_BIN_EXE_verdem")
+    );
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args([
+            "verify",
+            "--code",
+            &cmd,
+            "--code-name",
+            "positions",
+            "--only",
+            "ratchet",
+        ])
+        .arg("--cases")
+        .arg(cases())
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stdout);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{text}{err}");
+    assert!(text.contains("not run (they need a full solver)"), "{text}");
+    let rows: Vec<&str> = text.lines().filter(|l| l.starts_with("ratchet")).collect();
+    assert_eq!(rows.len(), 4, "{text}");
+    assert!(rows
+        .iter()
+        .all(|l| l.contains("code:positions") && l.ends_with("PASS")));
+}
+
+/// The Python law's rows, gated as verdem's MercuryDPM law.
+fn python_rows(defect: Option<&str>) -> Vec<Row> {
+    let scratch = tempfile::tempdir().unwrap();
+    let args = defect.map_or(String::new(), |d| format!("--defect {d}"));
+    let program = External::new(&script("contact_law.py", &args), "law", scratch.path());
+    code_rows(&program, Some(Tangential::Mercury))
+}
+
+fn set(rows: &[(&str, &str)]) -> BTreeSet<(String, String)> {
+    rows.iter()
+        .map(|(c, q)| (c.to_string(), q.to_string()))
+        .collect()
+}
+
+#[test]
+fn the_correct_python_law_passes_and_measures_what_verdems_mercury_law_measures() {
+    let rows = python_rows(None);
+    let own = own_rows(Tangential::Mercury);
+    assert_eq!(rows.len(), own.len());
+    assert!(failed(&rows).is_empty(), "{:#?}", failed(&rows));
+    for (r, o) in rows.iter().zip(&own) {
+        // an independent implementation of the same arithmetic, through the files
+        assert!(
+            (r.measured - o.measured).abs() <= 1e-7 + 1e-9 * o.measured.abs(),
+            "{r:?} {o:?}"
+        );
+        assert!(r.gate && r.passed(), "{r:?}");
+        // where MercuryDPM's convention misses the expected value (no twist about the
+        // normal, ratcheting), the program is held to verdem's number instead
+        if !o.passed() {
+            assert_eq!(r.limit.expected(), o.measured, "{r:?}");
+            assert!(r.quantity.ends_with("= verdem mercury"), "{r:?}");
+        }
+    }
+    assert!(own.iter().any(|o| !o.passed()));
+}
+
+// Which rows a defect fails, and why: the defect changes what that row measures.
+
+#[test]
+fn a_spring_not_turned_into_the_new_tangent_plane_fails_the_rotations_out_of_the_plane() {
+    let rows = python_rows(Some("rotation"));
+    // every rotation with a component in the tangent plane tilts the contact plane away
+    // from the spring (|Ft| falls by 1 − cos 1 per radian); about the normal nothing tilts
+    assert_eq!(
+        failed(&rows),
+        set(&[
+            (
+                "objectivity code:law tangent axis",
+                "|Ft| drift per rad = verdem mercury"
+            ),
+            (
+                "objectivity code:law oblique axis",
+                "|Ft| drift per rad = verdem mercury"
+            ),
+            (
+                "objectivity code:law oblique axis",
+                "Ft direction error per rad = verdem mercury"
+            ),
+            (
+                "ratchet code:law rotation about t",
+                "residual |Ft| / peak |Ft| = verdem mercury"
+            ),
+        ])
+    );
+}
+
+#[test]
+fn a_tangential_stiffness_10_percent_off_fails_the_spring_force_and_energy_rows() {
+    let rows = python_rows(Some("kt"));
+    // the spring force for a given slip, the spring after the Coulomb reset, and the work of
+    // the cycle measured in the elastic energy of the case's kt
+    assert_eq!(
+        failed(&rows),
+        set(&[
+            (
+                "tangential code:law load-unload",
+                "F2.(t x n) / (kt l2 phi)"
+            ),
+            (
+                "tangential code:law coulomb limit",
+                "|Ft| / (mu fn) back by mu fn/kt"
+            ),
+            (
+                "ratchet code:law rotation about n",
+                "net work / peak elastic energy = verdem mercury"
+            ),
+        ])
+    );
+}
+
+#[test]
+fn torques_of_the_wrong_sign_fail_the_torque_and_work_rows() {
+    let rows = python_rows(Some("torque"));
+    // both torques, their balance with r × F, and the work the torques do in the cycles
+    assert_eq!(
+        failed(&rows),
+        set(&[
+            ("tangential code:law load-unload", "T1.t / (l1 |Ft|)"),
+            ("tangential code:law load-unload", "T2.t / (l2 |Ft|)"),
+            (
+                "tangential code:law load-unload",
+                "|T1 + T2 + r x F2| / (d |Ft|)"
+            ),
+            (
+                "ratchet code:law rotation about n",
+                "net work / peak elastic energy = verdem mercury"
+            ),
+            (
+                "ratchet code:law rotation about t",
+                "net work / peak elastic energy = verdem mercury"
+            ),
+        ])
+    );
+}
+
+#[test]
+fn a_spring_kept_through_a_contact_loss_fails_the_reset_row() {
+    let rows = python_rows(Some("reset"));
+    assert_eq!(
+        failed(&rows),
+        set(&[("tangential code:law contact loss", "|Ft| back / (mu fn)")])
+    );
+}
+
+/// `verdem verify --code CMD --only load-unload`: its exit status, standard output and error.
+fn broken(cmd: &str, out: &Path) -> (Option<i32>, String, String) {
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(["verify", "--only", "load-unload", "--code", cmd, "--out"])
+        .arg(out)
+        .arg("--cases")
+        .arg(cases())
+        .output()
+        .unwrap();
+    (
+        run.status.code(),
+        String::from_utf8_lossy(&run.stdout).into_owned(),
+        String::from_utf8_lossy(&run.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_broken_program_gets_an_error_row_naming_what_went_wrong() {
+    let out = tempfile::tempdir().unwrap();
+    // one case, one run of the program: its files are in the folder run000
+    let forces = format!("{}/code/run000/FORCES.csv", out.path().display());
+    for (fault, message) in [
+        (
+            "crash",
+            "ended with exit code 1; its last error lines:".to_string(),
+        ),
+        (
+            "short",
+            format!("{forces}: 220 rows of forces for 221 rows of motion"),
+        ),
+        (
+            "nan",
+            format!("{forces}:4: fx1: not a finite number: \"nan\""),
+        ),
+        ("header", format!("{forces}:1: header must be `t,fx1")),
+    ] {
+        let _ = std::fs::remove_dir_all(out.path().join("code"));
+        let (status, stdout, stderr) = broken(&script("faulty.py", fault), out.path());
+        assert_eq!(status, Some(1), "{fault}: {stdout}{stderr}");
+        assert!(!stderr.contains("panicked"), "{fault}: {stderr}");
+        let row = stdout
+            .lines()
+            .find(|l| l.starts_with("tangential code:faulty.py load-unload"))
+            .unwrap_or_else(|| panic!("{fault}: {stdout}"));
+        assert!(row.ends_with("ERROR"), "{fault}: {row}");
+        assert!(stdout.contains(&message), "{fault}: {message}\n{stdout}");
+        assert!(
+            stdout.contains("its files are kept in"),
+            "{fault}: {stdout}"
+        );
+    }
+    // the traceback's last line is shown
+    let (_, stdout, _) = broken(&script("faulty.py", "crash"), out.path());
+    assert!(
+        stdout.contains("RuntimeError: the law diverged"),
+        "{stdout}"
+    );
+    // a program that does not exist
+    let (status, stdout, _) = broken("/nonexistent/law", out.path());
+    assert_eq!(status, Some(1));
+    assert!(
+        stdout.contains("exit code 127 (the command was not found)"),
+        "{stdout}"
+    );
+}
