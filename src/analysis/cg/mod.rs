@@ -3,6 +3,7 @@
 //! the averages), with standard errors from block averaging over saves, built-in physics checks
 //! and a plot. Any code's output in this format is judged by the same yardstick.
 
+pub mod blocking;
 pub mod checks;
 pub mod compare;
 pub mod fields;

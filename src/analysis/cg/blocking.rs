@@ -1,0 +1,186 @@
+//! Standard errors of profiles from blocks as long as each field's own correlation: every
+//! column of [`super::COLUMNS`] gets its integrated autocorrelation time, measured on the series
+//! it is averaged from (saves, or bins of in-run samples), and its error from blocks of at
+//! least [`block_length_for`] units of that series.
+
+use super::fields::{derive, Grid, Raw};
+use super::{columns, core_range, COLUMNS};
+use crate::analysis::stats::{block, block_length_for, integrated_autocorrelation, median};
+
+/// One unit of the series a profile is averaged from: a save, or a bin of in-run samples. It
+/// holds the sums of its samples' raw fields and how many samples of the particles (volume
+/// fraction, density, momentum, flux) and of the contacts (contact stress) it holds.
+#[derive(Clone, Debug)]
+pub struct Unit {
+    pub sum: Raw,
+    pub particle_samples: u64,
+    pub contact_samples: u64,
+}
+
+impl Unit {
+    /// No samples on `n` grid points.
+    pub fn empty(n: usize) -> Unit {
+        Unit {
+            sum: Raw::zeros(n),
+            particle_samples: 0,
+            contact_samples: 0,
+        }
+    }
+
+    /// The unit of one save: one sample of everything.
+    pub fn of_save(raw: Raw) -> Unit {
+        Unit {
+            sum: raw,
+            particle_samples: 1,
+            contact_samples: 1,
+        }
+    }
+
+    /// Adds the samples of `other`.
+    pub fn merge(&mut self, other: &Unit) {
+        self.sum.add_scaled(&other.sum, 1.0);
+        self.particle_samples += other.particle_samples;
+        self.contact_samples += other.contact_samples;
+    }
+
+    /// The mean raw fields of its samples: particle fields over the particle samples, contact
+    /// stress over the contact samples (zero where there are none).
+    pub fn mean(&self) -> Raw {
+        let per = |n: u64| if n > 0 { 1.0 / n as f64 } else { 0.0 };
+        let (p, c) = (per(self.particle_samples), per(self.contact_samples));
+        let s = &self.sum;
+        Raw {
+            nu: s.nu.iter().map(|v| v * p).collect(),
+            rho: s.rho.iter().map(|v| v * p).collect(),
+            momentum: s.momentum.iter().map(|v| v * p).collect(),
+            flux: s.flux.iter().map(|v| v * p).collect(),
+            contact: s.contact.iter().map(|v| v * c).collect(),
+        }
+    }
+}
+
+/// All samples of `units` merged.
+pub fn merged(units: &[Unit]) -> Unit {
+    let mut all = Unit::empty(units.first().map_or(0, |u| u.sum.nu.len()));
+    for u in units {
+        all.merge(u);
+    }
+    all
+}
+
+/// The columns of [`COLUMNS`] derived from the mean of each of `blocks` consecutive blocks of
+/// `units`, per block, per grid point.
+pub fn block_columns(units: &[Unit], blocks: usize) -> Vec<Vec<Vec<f64>>> {
+    (0..blocks)
+        .map(|b| {
+            derive(&merged(&units[block(b, blocks, units.len())]).mean())
+                .iter()
+                .map(columns)
+                .collect()
+        })
+        .collect()
+}
+
+/// Per column of [`COLUMNS`]: the integrated autocorrelation time (in units) of its series,
+/// the blocks its standard error comes from and whether they are [`block_length_for`] long.
+#[derive(Clone, Debug)]
+pub struct FieldErrors {
+    pub tau: Vec<f64>,
+    pub blocks: Vec<usize>,
+    pub long_enough: Vec<bool>,
+    /// Standard error of each column, per grid point.
+    pub se: Vec<Vec<f64>>,
+}
+
+/// The integrated autocorrelation time of each column: the larger of that of its core mean
+/// (the average over the core slices, [`core_range`]) and the median over the core slices of
+/// each slice's own; NaN for fewer than four units.
+pub fn field_taus(units: &[Unit], grid: &Grid) -> Vec<f64> {
+    let per_unit: Vec<Vec<Vec<f64>>> = units
+        .iter()
+        .map(|u| derive(&u.mean()).iter().map(columns).collect())
+        .collect();
+    let core = core_range(grid);
+    (0..COLUMNS.len())
+        .map(|c| {
+            let core_mean: Vec<f64> = per_unit
+                .iter()
+                .map(|u| core.clone().map(|k| u[k][c]).sum::<f64>() / core.len() as f64)
+                .collect();
+            let slices: Vec<f64> = core
+                .clone()
+                .map(|k| {
+                    let s: Vec<f64> = per_unit.iter().map(|u| u[k][c]).collect();
+                    integrated_autocorrelation(&s)
+                })
+                .collect();
+            let tau = integrated_autocorrelation(&core_mean);
+            if tau.is_nan() {
+                tau
+            } else {
+                tau.max(median(&slices))
+            }
+        })
+        .collect()
+}
+
+/// Standard errors of every column from blocks of at least [`block_length_for`] its own τ
+/// ([`field_taus`]); where the units are too few for [`crate::analysis::stats::MIN_BLOCKS`]
+/// such blocks, from that many shorter ones, flagged.
+pub fn field_errors(units: &[Unit], grid: &Grid) -> FieldErrors {
+    let tau = field_taus(units, grid);
+    let chosen: Vec<(usize, bool)> = tau
+        .iter()
+        .map(|&t| crate::analysis::stats::blocks_for(units.len(), t))
+        .collect();
+    let mut cache: Vec<(usize, Vec<Vec<Vec<f64>>>)> = Vec::new();
+    let mut se = vec![vec![0.0; COLUMNS.len()]; grid.n];
+    for (c, &(blocks, _)) in chosen.iter().enumerate() {
+        if !cache.iter().any(|(b, _)| *b == blocks) {
+            cache.push((blocks, block_columns(units, blocks)));
+        }
+        let (_, cols) = cache.iter().find(|(b, _)| *b == blocks).expect("cached");
+        for (k, row) in se.iter_mut().enumerate() {
+            let vals: Vec<f64> = cols.iter().map(|b| b[k][c]).collect();
+            row[c] = crate::analysis::stats::standard_error(&vals);
+        }
+    }
+    FieldErrors {
+        tau,
+        blocks: chosen.iter().map(|c| c.0).collect(),
+        long_enough: chosen.iter().map(|c| c.1).collect(),
+        se,
+    }
+}
+
+/// The blocks' length needed by the slowest column, as a block count of `units`: the fewest
+/// blocks of [`FieldErrors::blocks`] (used for the checks' core means and steadiness trend).
+pub fn common_blocks(errors: &FieldErrors) -> usize {
+    errors.blocks.iter().copied().min().unwrap_or(1)
+}
+
+/// A line per field of the benchmark ([`super::FIELDS`]) and per stress component of the
+/// checks: its τ in `unit`s and its blocks.
+pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
+    let mut s = String::new();
+    for (c, name) in COLUMNS.iter().enumerate() {
+        let len = block_length_for(errors.tau[c]);
+        s.push_str(&format!(
+            "  {name:9} tau {:>8.2} {unit}, {:>5} blocks of {:>7.1} (needs >= {}){}\n",
+            errors.tau[c],
+            errors.blocks[c],
+            units as f64 / errors.blocks[c] as f64,
+            if len.is_finite() {
+                format!("{len}")
+            } else {
+                "?".into()
+            },
+            if errors.long_enough[c] {
+                ""
+            } else {
+                ": TOO SHORT, error too small"
+            }
+        ));
+    }
+    s
+}
