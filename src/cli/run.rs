@@ -50,8 +50,8 @@ pub struct Args {
     #[arg(long)]
     vtk: bool,
     /// In-run averaging of the bumpy-shear profiles: sample the contact stress and the wall
-    /// forces every K steps (0 = no in-run averaging; default: half the free–free contact
-    /// duration, docs/statistics.md).
+    /// forces every K steps (0 = no in-run averaging; default: 8 free–free contact durations,
+    /// docs/statistics.md).
     #[arg(long)]
     inrun_every: Option<u64>,
     /// Sample the particle fields of the in-run profiles every KP steps, a multiple of
@@ -244,10 +244,10 @@ fn in_run(
     resumed: bool,
 ) -> anyhow::Result<Option<Inrun>> {
     let start = engine.state().step;
-    // Samples per contact duration and contact durations per particle sample (docs/statistics.md).
+    // Intervals in contact durations (docs/statistics.md).
     let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
     let every =
-        every.unwrap_or_else(|| (tc_steps / inrun::SAMPLES_PER_CONTACT).round().max(1.0) as u64);
+        every.unwrap_or_else(|| (tc_steps * inrun::CONTACTS_PER_SAMPLE).round().max(1.0) as u64);
     if every == 0 {
         return Ok(None);
     }

@@ -93,14 +93,17 @@ pub struct FieldErrors {
 }
 
 /// The integrated autocorrelation time of each column: the larger of that of its core mean
-/// (the average over the core slices, [`core_range`]) and the median over the core slices of
-/// each slice's own; NaN for fewer than four units.
+/// (the average over the core slices, [`core_range`], or over all slices when the box has no
+/// core) and the median over those slices of each slice's own; NaN for fewer than four units.
 pub fn field_taus(units: &[Unit], grid: &Grid) -> Vec<f64> {
     let per_unit: Vec<Vec<Vec<f64>>> = units
         .iter()
         .map(|u| derive(&u.mean()).iter().map(columns).collect())
         .collect();
-    let core = core_range(grid);
+    let core = match core_range(grid) {
+        r if r.is_empty() => 0..grid.n,
+        r => r,
+    };
     (0..COLUMNS.len())
         .map(|c| {
             let core_mean: Vec<f64> = per_unit
