@@ -277,4 +277,11 @@ fn a_run_writes_its_in_run_profiles_and_judges_them_beside_the_saves() {
         "{checks}"
     );
     assert!(checks.contains("SE ratio"), "{checks}");
+    // 3 contact samples in one bin: no autocorrelation time, and no NaN written for it
+    assert!(
+        checks.contains("samples: undefined samples (pressure)"),
+        "{checks}"
+    );
+    let mut words = checks.split(|c: char| !c.is_alphanumeric());
+    assert!(!words.any(|w| w == "NaN" || w == "inf"), "{checks}");
 }

@@ -367,8 +367,8 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
     let mut out = format!(
         "\nin-run averaging: steps {}..{} (after {}), contact stress and wall forces every {} \
          steps ({} samples), particle fields every {} steps ({} samples), {} bins of {} steps; \
-         autocorrelation time of the core contact stress over its first {} samples: {:.2} \
-         samples (pressure), {:.2} (shear)\n",
+         autocorrelation time of the core contact stress over its first {} samples: {} \
+         samples (pressure), {} (shear)\n",
         s.from + 1,
         s.to,
         s.from,
@@ -379,8 +379,8 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         p.saves.len(),
         r.bin_steps,
         r.trace_len,
-        r.contact_tau[0],
-        r.contact_tau[1],
+        blocking::shown(r.contact_tau[0]),
+        blocking::shown(r.contact_tau[1]),
     );
     out.push_str("per-field errors of the saves (tau in saves):\n");
     out.push_str(&blocking::describe(save_errors, saves.saves.len(), "saves"));
@@ -401,6 +401,9 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         "core means, saves (block errors as profiles.csv) vs in-run (each field's own blocks), \
          judged equal within 3 combined SE:\n",
     );
+    if core_range(&p.grid).is_empty() {
+        return out;
+    }
     let save_units: Vec<Unit> = saves.per_save.iter().cloned().map(Unit::of_save).collect();
     for name in ["nu", "T", "pressure", "shear_xz", "con_xz", "con_zz"] {
         let c = COLUMNS.iter().position(|x| *x == name).expect("column");

@@ -162,15 +162,24 @@ pub fn common_blocks(errors: &FieldErrors) -> usize {
     errors.blocks.iter().copied().min().unwrap_or(1)
 }
 
-/// A line per field of the benchmark ([`super::FIELDS`]) and per stress component of the
-/// checks: its τ in `unit`s and its blocks.
+/// `x` with two decimals, or "undefined" when it is not finite (no NaN in a report).
+pub fn shown(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.2}")
+    } else {
+        "undefined".into()
+    }
+}
+
+/// A line per column of [`COLUMNS`]: its τ in `unit`s, its blocks (of `units` in all) and the
+/// block length it needs.
 pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
     let mut s = String::new();
     for (c, name) in COLUMNS.iter().enumerate() {
         let len = block_length_for(errors.tau[c]);
         s.push_str(&format!(
-            "  {name:9} tau {:>8.2} {unit}, {:>5} blocks of {:>7.1} (needs >= {}){}\n",
-            errors.tau[c],
+            "  {name:9} tau {:>8} {unit}, {:>5} blocks of {:>7.1} (needs >= {}){}\n",
+            shown(errors.tau[c]),
             errors.blocks[c],
             units as f64 / errors.blocks[c] as f64,
             if len.is_finite() {
