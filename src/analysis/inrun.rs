@@ -15,7 +15,7 @@ use crate::analysis::cg::blocking::{self, FieldErrors, Unit};
 use crate::analysis::cg::fields::{derive, Grid, Raw};
 use crate::analysis::cg::kernel::Kernel;
 use crate::analysis::cg::{
-    checks, columns, core_range, table::Table, CgOptions, KernelChoice, Profiles, COLUMNS,
+    checks, columns, core_range, table::Table, CgOptions, Profiles, COLUMNS,
 };
 use crate::analysis::stats::integrated_autocorrelation;
 use crate::analysis::{Limit, Verdict};
@@ -101,13 +101,7 @@ impl Inrun {
             z1: domain.hi.z,
             n: o.slices,
         };
-        let h = grid.h();
-        let width = o.width.unwrap_or(h);
-        let kernel = match o.kernel {
-            KernelChoice::Heaviside => Kernel::Heaviside { h },
-            KernelChoice::Gauss => Kernel::Gauss { w: width },
-            KernelChoice::Lucy => Kernel::Lucy { c: width },
-        };
+        let kernel = o.kernel_for(&grid);
         let l = domain.lengths();
         Ok(Inrun {
             sampling,
@@ -127,14 +121,10 @@ impl Inrun {
         })
     }
 
-    /// The sampling intervals and window.
-    pub fn sampling(&self) -> Sampling {
-        self.sampling
-    }
-
-    /// Adds the sample of the current state `snap` (its forces evaluated) to bin `b`: the
-    /// contact stress and wall forces, and the particle fields when `particles`.
-    pub fn sample(&mut self, snap: &Snapshot, particles: bool) {
+    /// Adds the sample of the state `snap` (its step in the window, its forces evaluated) to
+    /// the bin of its step: the contact stress and wall forces, and the particle fields when
+    /// `particles`.
+    fn sample(&mut self, snap: &Snapshot, particles: bool) {
         let step = snap.step;
         let mut b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
         while b >= MAX_BINS {
