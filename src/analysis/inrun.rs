@@ -36,7 +36,7 @@ pub const TRACE_SAMPLES: usize = 200_000;
 /// sampled every step has an integrated autocorrelation time of ~20 steps = 0.4 tc
 /// (docs/statistics.md), so samples 8 tc apart are independent and none is wasted; closer
 /// samples would carry more information per step, but each costs a stop of the run loop and a
-/// snapshot, ~2.4e6 instructions (~7 steps of the benchmark): at 8 tc that is ~2 % of the run.
+/// snapshot, 2.4–2.9e6 instructions (7–9 steps of the benchmark): at 8 tc, 2.6 % of the run.
 pub const CONTACTS_PER_SAMPLE: f64 = 8.0;
 
 /// Contact durations between two samples of the particle fields (docs/statistics.md: they
