@@ -32,15 +32,15 @@ pub const MAX_BINS: usize = 4096;
 /// autocorrelation time at the sampling interval.
 pub const TRACE_SAMPLES: usize = 200_000;
 
-/// Free–free contact durations tc between two contact-stress samples. The core contact stress
-/// sampled every step has an integrated autocorrelation time of ~20 steps = 0.4 tc
-/// (docs/statistics.md), so samples 8 tc apart are independent and none is wasted; closer
-/// samples would carry more information per step, but each costs a stop of the run loop and a
-/// snapshot, 2.4–2.9e6 instructions (7–9 steps of the benchmark): at 8 tc, 2.6 % of the run.
+/// Free–free contact durations tc between two contact-stress samples. A contact's force is a
+/// pulse of duration tc, so the contact stress decorrelates within ~tc (a half sine gives an
+/// integrated autocorrelation time 4tc/π²) and samples 8 tc apart are independent; closer
+/// samples would carry more information per step, but each costs a snapshot of the engine and a
+/// stop of the run loop, which at 8 tc stays within 3 % of the step (docs/statistics.md).
 pub const CONTACTS_PER_SAMPLE: f64 = 8.0;
 
-/// Contact durations between two samples of the particle fields (docs/statistics.md: they
-/// change on the time between a particle's collisions, thousands of steps).
+/// Contact durations between two samples of the particle fields: they change on the time
+/// between a particle's collisions, many contact durations (docs/statistics.md).
 pub const CONTACTS_PER_PARTICLE_SAMPLE: f64 = 20.0;
 
 /// When to sample.
