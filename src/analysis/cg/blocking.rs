@@ -196,3 +196,73 @@ pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n` values of an AR(1) series x_(k+1) = a x_k + u_k, u uniform on [−½, ½], from a seeded
+    /// linear congruential generator.
+    fn ar1(a: f64, n: usize, seed: u64) -> Vec<f64> {
+        let (mut seed, mut x) = (seed, 0.0);
+        (0..n)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                x = a * x + ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+                x
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_column_gets_its_own_autocorrelation_time_and_blocks() {
+        // 20000 saves of a box [0, 10] in 10 slices (core: z in [3, 7]): the volume fraction
+        // follows a slow AR(1) series (a = 0.8, τ = 4.5), the x momentum a fast one (a = 0,
+        // τ = ½), the same in every slice; density 1, no contacts.
+        let grid = Grid {
+            z0: 0.0,
+            z1: 10.0,
+            n: 10,
+        };
+        let n = 20_000;
+        let (slow, fast) = (ar1(0.8, n, 1), ar1(0.0, n, 2));
+        let units: Vec<Unit> = (0..n)
+            .map(|t| {
+                let mut raw = Raw::zeros(grid.n);
+                for k in 0..grid.n {
+                    raw.nu[k] = 0.5 + slow[t];
+                    raw.rho[k] = 1.0;
+                    raw.momentum[k].x = fast[t];
+                }
+                Unit::of_save(raw)
+            })
+            .collect();
+        let e = field_errors(&units, &grid);
+        let col = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+        let (nu, vx, con) = (col("nu"), col("vx"), col("con_xz"));
+        assert!((e.tau[nu] - 4.5).abs() < 0.5, "{}", e.tau[nu]);
+        assert!((e.tau[vx] - 0.5).abs() < 0.1, "{}", e.tau[vx]);
+        assert_eq!(e.tau[con], 0.5, "a constant column");
+        // blocks of at least 5(2τ − 1) ≈ 40 saves for ν, of one save for vx
+        assert!(
+            e.long_enough[nu] && n / e.blocks[nu] >= 35,
+            "{}",
+            e.blocks[nu]
+        );
+        assert_eq!(e.blocks[vx], n);
+        // the errors are the known √(2τ·variance/n) of each series (within 10 %)
+        let exact = |tau: f64, a: f64| (2.0 * tau * (1.0 / 12.0) / (1.0 - a * a) / n as f64).sqrt();
+        assert!(
+            (e.se[5][nu] / exact(4.5, 0.8) - 1.0).abs() < 0.1,
+            "{}",
+            e.se[5][nu]
+        );
+        assert!(
+            (e.se[5][vx] / exact(0.5, 0.0) - 1.0).abs() < 0.1,
+            "{}",
+            e.se[5][vx]
+        );
+    }
+}
