@@ -154,12 +154,13 @@ pub fn run_files(dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// The files of a run besides its numbered saves, after `NAME.`.
-const OWN_FILES: [&str; 9] = [
+const OWN_FILES: [&str; 10] = [
     "pvd",
     "checkpoint",
     "diagnostics.csv",
     "summary.toml",
     "profiles.csv",
+    "profiles_inrun.csv",
     "profiles.png",
     "checks.txt",
     "particles.png",
@@ -211,11 +212,31 @@ pub fn claim_output_folder(
     Ok(found.len())
 }
 
+/// Something that looks at the engine between steps without changing it (in-run averaging,
+/// `crate::analysis::inrun`): the run loop stops at each step it asks for and calls it there,
+/// with that step's forces evaluated. Where the loop stops does not change the steps.
+pub trait Observer {
+    /// The first step after `step` the observer wants to look at, if any.
+    fn next_after(&self, step: u64) -> Option<u64>;
+    /// Looks at the engine's current step.
+    fn observe(&mut self, engine: &dyn Engine);
+}
+
 /// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists.
 pub fn run(
     engine: &mut dyn Engine,
     opts: &RunOptions,
     resumed: bool,
+) -> anyhow::Result<RunSummary> {
+    run_observed(engine, opts, resumed, None)
+}
+
+/// [`run`], stopping also at the steps `observer` asks for and showing it the engine there.
+pub fn run_observed(
+    engine: &mut dyn Engine,
+    opts: &RunOptions,
+    resumed: bool,
+    mut observer: Option<&mut dyn Observer>,
 ) -> anyhow::Result<RunSummary> {
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
@@ -258,6 +279,14 @@ pub fn run(
             write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
         }
+        if let Some(o) = observer.as_deref_mut() {
+            if step != start_step && o.next_after(step - 1) == Some(step) {
+                if !engine.state().forces_ready {
+                    engine.advance(0).map_err(|f| kept.stopped(f))?;
+                }
+                o.observe(engine);
+            }
+        }
         first = false;
         if step >= opts.end_step {
             break false;
@@ -276,6 +305,9 @@ pub fn run(
         }
         if let Some(k) = step.checked_div(opts.checkpoint_every) {
             next = next.min((k + 1) * opts.checkpoint_every);
+        }
+        if let Some(s) = observer.as_deref().and_then(|o| o.next_after(step)) {
+            next = next.min(s);
         }
         engine.advance(next - step).map_err(|f| kept.stopped(f))?;
         if let Some(b) = &bar {

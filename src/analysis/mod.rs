@@ -5,6 +5,7 @@
 //! ([`particles`]).
 
 pub mod cg;
+pub mod inrun;
 pub mod particles;
 pub mod stats;
 pub mod tradeoff;

@@ -7,11 +7,13 @@ use std::sync::Arc;
 
 use anyhow::Context;
 
+use verdem::analysis::cg::blocking::{self, Unit};
 use verdem::analysis::cg::{self, CgOptions};
+use verdem::analysis::inrun::{self, Inrun, Sampling};
 use verdem::analysis::particles;
 use verdem::case::{Case, Scene};
 use verdem::io::vtk::Particle;
-use verdem::io::{checkpoint, mercury};
+use verdem::io::{atomic, checkpoint, mercury};
 use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
 use verdem::state::Motion;
 use verdem::step::Engine;
@@ -47,6 +49,15 @@ pub struct Args {
     /// `[output] vtk = true` in the case).
     #[arg(long)]
     vtk: bool,
+    /// In-run averaging of the bumpy-shear profiles: sample the contact stress and the wall
+    /// forces every K steps (0 = no in-run averaging; default: 8 free–free contact durations,
+    /// docs/statistics.md).
+    #[arg(long)]
+    inrun_every: Option<u64>,
+    /// Sample the particle fields of the in-run profiles every KP steps, a multiple of
+    /// --inrun-every (default: the multiple nearest to 20 contact durations).
+    #[arg(long)]
+    inrun_particle_every: Option<u64>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -113,7 +124,24 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         vtk: a.vtk || case.output.vtk,
         stop: Some(stop_on_signal()?),
     };
-    let s = run::run(engine.as_mut(), &opts, a.resume.is_some())?;
+    let shear = matches!(case.scene, Scene::BumpyShear { .. });
+    let mut inrun = if shear {
+        in_run(
+            (a.inrun_every, a.inrun_particle_every),
+            &case,
+            engine.as_ref(),
+            &opts,
+            a.resume.is_some(),
+        )?
+    } else {
+        None
+    };
+    let s = run::run_observed(
+        engine.as_mut(),
+        &opts,
+        a.resume.is_some(),
+        inrun.as_mut().map(|i| i as &mut dyn run::Observer),
+    )?;
     let limit = engine.params().guard.overlap;
     if s.deepest_overlap > OVERLAP_WARNING * limit {
         eprintln!(
@@ -142,7 +170,6 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         s.saves,
         opts.out_dir.display()
     );
-    let shear = matches!(case.scene, Scene::BumpyShear { .. });
     let threads = engine.params().threads;
     if s.steps_run > 0 {
         let projection = if shear {
@@ -184,7 +211,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         println!("particles: {}", png.display());
     }
     if s.saves > 0 && shear {
-        let (_, report) =
+        let (saved, mut report) =
             cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
         println!(
             "profiles: {}",
@@ -192,6 +219,16 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
                 .join(format!("{}.profiles.csv", case.name))
                 .display()
         );
+        if let Some(r) = inrun.as_ref().and_then(inrun::Inrun::result) {
+            let path = inrun::csv_path(&opts.out_dir, &case.name);
+            atomic::write(&path, inrun::csv(&r).as_bytes())?;
+            println!("in-run profiles: {}", path.display());
+            let units: Vec<Unit> = saved.per_save.iter().cloned().map(Unit::of_save).collect();
+            let save_errors = blocking::field_errors(&units, &saved.grid);
+            report.push_str(&inrun::report(&r, &saved, &save_errors));
+            let checks = opts.out_dir.join(format!("{}.checks.txt", case.name));
+            atomic::write(&checks, report.as_bytes())?;
+        }
         print!("{report}");
     } else if s.saves > 0 {
         println!(
@@ -200,6 +237,53 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         );
     }
     Ok(Finished::Done)
+}
+
+/// The in-run averaging of a bumpy-shear run, over the steps of the saves `verdem cg` takes by
+/// default (the second half of the run's saves), or `None` with `--inrun-every 0`. `every` and
+/// `particle_every` are the command line's intervals, when given.
+fn in_run(
+    (every, particle_every): (Option<u64>, Option<u64>),
+    case: &Case,
+    engine: &dyn Engine,
+    opts: &RunOptions,
+    resumed: bool,
+) -> anyhow::Result<Option<Inrun>> {
+    let start = engine.state().step;
+    // Intervals in contact durations (docs/statistics.md).
+    let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
+    let every =
+        every.unwrap_or_else(|| (tc_steps * inrun::CONTACTS_PER_SAMPLE).round().max(1.0) as u64);
+    if every == 0 {
+        return Ok(None);
+    }
+    let particle_every = particle_every.unwrap_or_else(|| {
+        let target = inrun::CONTACTS_PER_PARTICLE_SAMPLE * tc_steps;
+        ((target / every as f64).round().max(1.0) as u64) * every
+    });
+    // The saves cg averages by default: the second half of those the folder will hold.
+    let first = if resumed {
+        run::saves_of(&opts.out_dir, &opts.name)?
+            .first()
+            .copied()
+            .unwrap_or(0)
+    } else {
+        start.div_ceil(opts.save_every)
+    };
+    let last = opts.end_step / opts.save_every;
+    let n = (last + 1).saturating_sub(first);
+    let from = (first + n.div_ceil(2).min(n.saturating_sub(1))) * opts.save_every;
+    let sampling = Sampling {
+        every,
+        particle_every,
+        from: from.max(start),
+        to: opts.end_step,
+    };
+    Ok(Some(Inrun::new(
+        &CgOptions::for_case(case),
+        &engine.state().domain,
+        sampling,
+    )?))
 }
 
 /// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has

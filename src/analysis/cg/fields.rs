@@ -35,6 +35,56 @@ impl Raw {
         }
     }
 
+    /// Adds a free particle at height `z` with velocity `v` and radius `radius` (particle
+    /// density `density`) to the volume fraction, density, momentum and momentum flux; `area` is
+    /// Lx·Ly, which every weight is divided by.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_particle(
+        &mut self,
+        z: f64,
+        v: Vec3,
+        radius: f64,
+        density: f64,
+        grid: &Grid,
+        kernel: Kernel,
+        area: f64,
+    ) {
+        let vol = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+        let m = vol * density;
+        for k in grid.near(z, z, kernel.reach()) {
+            let w = kernel.point(z, grid.z(k)) / area;
+            if w != 0.0 {
+                self.nu[k] += vol * w;
+                self.rho[k] += m * w;
+                self.momentum[k] += m * w * v;
+                self.flux[k] += m * w * v * v.transpose();
+            }
+        }
+    }
+
+    /// Adds the contact stress f⊗l of one contact: `f` is the force on particle i, whose centre
+    /// is at height `z_i`, and `branch` the vector from the branch's start (the partner's centre
+    /// for a free–free contact, the contact point for a free–wall one) to that centre, spread
+    /// along the branch by the kernel's exact line integral.
+    pub fn add_contact(
+        &mut self,
+        z_i: f64,
+        branch: Vec3,
+        f: Vec3,
+        grid: &Grid,
+        kernel: Kernel,
+        area: f64,
+    ) {
+        let z_start = z_i - branch.z;
+        let tensor = f * branch.transpose();
+        for k in grid.near(z_i, z_start, kernel.reach()) {
+            let w = kernel.line(z_i, z_start, grid.z(k)) / area;
+            if w != 0.0 {
+                self.contact[k] += w * tensor;
+            }
+        }
+    }
+
     /// self += s·other.
     pub fn add_scaled(&mut self, other: &Raw, s: f64) {
         for k in 0..self.nu.len() {
@@ -86,23 +136,12 @@ pub fn raw_fields(
 ) -> Raw {
     let l = domain.lengths();
     let area = l.x * l.y;
-    let reach = kernel.reach();
     let mut raw = Raw::zeros(grid.n);
     for (i, p) in data.rows.iter().enumerate() {
         if is_wall(i) {
             continue;
         }
-        let vol = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3);
-        let m = vol * density;
-        for k in grid.near(p.x.z, p.x.z, reach) {
-            let w = kernel.point(p.x.z, grid.z(k)) / area;
-            if w != 0.0 {
-                raw.nu[k] += vol * w;
-                raw.rho[k] += m * w;
-                raw.momentum[k] += m * w * p.v;
-                raw.flux[k] += m * w * p.v * p.v.transpose();
-            }
-        }
+        raw.add_particle(p.x.z, p.v, p.radius, density, grid, kernel, area);
     }
     for r in &fstat.rows {
         let (i, j) = (r.i, r.j);
@@ -118,14 +157,7 @@ pub fn raw_fields(
         // the centre of i, as a minimum-image vector.
         let start = if wj { r.c } else { data.rows[j].x };
         let branch = domain.min_image(xi - start);
-        let z_start = xi.z - branch.z;
-        let tensor = f * branch.transpose();
-        for k in grid.near(xi.z, z_start, reach) {
-            let w = kernel.line(xi.z, z_start, grid.z(k)) / area;
-            if w != 0.0 {
-                raw.contact[k] += w * tensor;
-            }
-        }
+        raw.add_contact(xi.z, branch, f, grid, kernel, area);
     }
     raw
 }

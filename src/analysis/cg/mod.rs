@@ -3,6 +3,7 @@
 //! the averages), with standard errors from block averaging over saves, built-in physics checks
 //! and a plot. Any code's output in this format is judged by the same yardstick.
 
+pub mod blocking;
 pub mod checks;
 pub mod compare;
 pub mod fields;
@@ -80,6 +81,20 @@ impl CgOptions {
             density: case.material.density,
             periodic: case.domain.periodic,
             ..CgOptions::default()
+        }
+    }
+}
+
+impl CgOptions {
+    /// The kernel of these options on `grid`: Heaviside slices of the grid's height, or a Gauss
+    /// or Lucy kernel of `width` (default the slice height).
+    pub fn kernel_for(&self, grid: &Grid) -> Kernel {
+        let h = grid.h();
+        let width = self.width.unwrap_or(h);
+        match self.kernel {
+            KernelChoice::Heaviside => Kernel::Heaviside { h },
+            KernelChoice::Gauss => Kernel::Gauss { w: width },
+            KernelChoice::Lucy => Kernel::Lucy { c: width },
         }
     }
 }
@@ -264,13 +279,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         z1: head.domain_hi.z,
         n: o.slices,
     };
-    let h = grid.h();
-    let width = o.width.unwrap_or(h);
-    let kernel = match o.kernel {
-        KernelChoice::Heaviside => Kernel::Heaviside { h },
-        KernelChoice::Gauss => Kernel::Gauss { w: width },
-        KernelChoice::Lucy => Kernel::Lucy { c: width },
-    };
+    let kernel = o.kernel_for(&grid);
     let walls = o.walls;
     let is_wall = move |i: usize| i < walls;
     let per: Vec<anyhow::Result<(Raw, [crate::Vec3; 2])>> = saves

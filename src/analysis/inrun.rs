@@ -1,0 +1,429 @@
+//! In-run averaging: the coarse-grained raw fields of `verdem cg` (the same slices, kernels and
+//! definitions, [`Raw::add_particle`] and [`Raw::add_contact`]) accumulated while a run
+//! advances, from the engine's own contacts and forces rather than from saves: the contact
+//! stress of the contacts alive every `every` steps, the force each wall receives at the same
+//! steps, and the particle fields every `particle_every` steps. Samples go into bins of
+//! consecutive steps (at most [`MAX_BINS`]; two neighbours merge when more would be needed), and
+//! the bins are the series the profiles' standard errors are taken from, with blocks as long as
+//! each field's own correlation ([`blocking::field_errors`]).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+
+use crate::analysis::cg::blocking::{self, FieldErrors, Unit};
+use crate::analysis::cg::fields::{derive, Grid, Raw};
+use crate::analysis::cg::kernel::Kernel;
+use crate::analysis::cg::{
+    checks, columns, core_range, table::Table, CgOptions, Profiles, COLUMNS,
+};
+use crate::analysis::stats::integrated_autocorrelation;
+use crate::analysis::{Limit, Verdict};
+use crate::contact::PairInput;
+use crate::run::Observer;
+use crate::state::{Domain, Snapshot};
+use crate::step::Engine;
+use crate::Vec3;
+
+/// Most bins kept: a run's samples are binned in at most this many bins of equal length.
+pub const MAX_BINS: usize = 4096;
+
+/// Most contact samples whose core means are kept one by one, for the contact stress's
+/// autocorrelation time at the sampling interval.
+pub const TRACE_SAMPLES: usize = 200_000;
+
+/// Free–free contact durations tc between two contact-stress samples. A contact's force is a
+/// pulse of duration tc, so the contact stress decorrelates within ~tc (a half sine gives an
+/// integrated autocorrelation time 4tc/π²) and samples 8 tc apart are independent; closer
+/// samples would carry more information per step, but each costs a snapshot of the engine and a
+/// stop of the run loop, which at 8 tc stays within 3 % of the step (docs/statistics.md).
+pub const CONTACTS_PER_SAMPLE: f64 = 8.0;
+
+/// Contact durations between two samples of the particle fields: they change on the time
+/// between a particle's collisions, many contact durations (docs/statistics.md).
+pub const CONTACTS_PER_PARTICLE_SAMPLE: f64 = 20.0;
+
+/// When to sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampling {
+    /// Contact stress and wall forces at every step that is a multiple of this.
+    pub every: u64,
+    /// Particle fields at every step that is a multiple of this (a multiple of `every`).
+    pub particle_every: u64,
+    /// Samples are taken at steps in (`from`, `to`].
+    pub from: u64,
+    pub to: u64,
+}
+
+/// The accumulator of a run's in-run profiles; it is the run loop's [`Observer`].
+pub struct Inrun {
+    sampling: Sampling,
+    grid: Grid,
+    kernel: Kernel,
+    walls: usize,
+    density: f64,
+    domain: Domain,
+    area: f64,
+    /// Steps per bin (a multiple of `particle_every`).
+    bin_steps: u64,
+    bins: Vec<Unit>,
+    /// Per bin: the sum over its contact samples of the force of the free particles on the
+    /// bottom [0] and top [1] wall spheres.
+    wall: Vec<[Vec3; 2]>,
+    /// The contact stress of the sample under way.
+    scratch: Raw,
+    /// Per contact sample (the first [`TRACE_SAMPLES`]): the core means of the contact pressure
+    /// and of the contact σxz.
+    trace: Vec<[f64; 2]>,
+    free: usize,
+    free_volume: f64,
+}
+
+impl Inrun {
+    /// An accumulator for the saves' coarse-graining `o` (its slices, kernel, wall spheres,
+    /// density and periodicity) of a run in `domain`. Refuses a `particle_every` that is not a
+    /// multiple of `every`, or a zero interval.
+    pub fn new(o: &CgOptions, domain: &Domain, sampling: Sampling) -> anyhow::Result<Inrun> {
+        if sampling.every == 0 || sampling.particle_every == 0 {
+            bail!("in-run sampling intervals must be at least 1 step");
+        }
+        if !sampling.particle_every.is_multiple_of(sampling.every) {
+            bail!(
+                "the particle fields' sampling interval ({}) must be a multiple of the contacts' \
+                 ({})",
+                sampling.particle_every,
+                sampling.every
+            );
+        }
+        let domain = Domain::new(domain.lo, domain.hi, o.periodic);
+        let grid = Grid {
+            z0: domain.lo.z,
+            z1: domain.hi.z,
+            n: o.slices,
+        };
+        let kernel = o.kernel_for(&grid);
+        let l = domain.lengths();
+        Ok(Inrun {
+            sampling,
+            scratch: Raw::zeros(grid.n),
+            grid,
+            kernel,
+            walls: o.walls,
+            density: o.density,
+            area: l.x * l.y,
+            domain,
+            bin_steps: sampling.particle_every,
+            bins: Vec::new(),
+            wall: Vec::new(),
+            trace: Vec::new(),
+            free: 0,
+            free_volume: 0.0,
+        })
+    }
+
+    /// Adds the sample of the state `snap` (its step in the window, its forces evaluated) to
+    /// the bin of its step: the contact stress and wall forces, and the particle fields when
+    /// `particles`.
+    fn sample(&mut self, snap: &Snapshot, particles: bool) {
+        let step = snap.step;
+        let mut b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
+        while b >= MAX_BINS {
+            self.merge_neighbours();
+            b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
+        }
+        while self.bins.len() <= b {
+            self.bins.push(Unit::empty(self.grid.n));
+            self.wall.push([Vec3::zeros(); 2]);
+        }
+        let p = &snap.particles;
+        let (grid, kernel, area, density) = (&self.grid, self.kernel, self.area, self.density);
+        let unit = &mut self.bins[b];
+        if particles {
+            for i in self.walls..p.x.len() {
+                unit.sum
+                    .add_particle(p.x[i].z, p.v[i], p.radius[i], density, grid, kernel, area);
+            }
+            unit.particle_samples += 1;
+            self.free = p.x.len().saturating_sub(self.walls);
+            self.free_volume = p.radius[self.walls.min(p.x.len())..]
+                .iter()
+                .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+                .sum();
+        }
+        self.scratch.contact.fill(Default::default());
+        let mid = 0.5 * (self.domain.lo.z + self.domain.hi.z);
+        for c in &snap.contacts {
+            let (a, o) = (c.p as usize, c.i as usize);
+            let (wall_a, wall_o) = (a < self.walls, o < self.walls);
+            if wall_a && wall_o {
+                continue;
+            }
+            // The contact point exactly as the force pass and the .fstat rows have it.
+            let Some(g) = (PairInput {
+                r: self.domain.min_image(p.x[a] - p.x[o]),
+                rad_p: p.radius[a],
+                rad_i: p.radius[o],
+                v_p: Vec3::zeros(),
+                v_i: Vec3::zeros(),
+                w_p: Vec3::zeros(),
+                w_i: Vec3::zeros(),
+            })
+            .kinematics() else {
+                continue;
+            };
+            let point = p.x[a] + g.arm_p;
+            // As `verdem cg`: f on the lower-indexed free particle i, the branch from the
+            // partner's centre (free–free) or from the contact point (free–wall) to i.
+            let (i, f, start) = match (wall_a, wall_o) {
+                (false, false) => (a, c.force.f, p.x[o]),
+                (false, true) => (a, c.force.f, point),
+                _ => (o, -c.force.f, point),
+            };
+            let branch = self.domain.min_image(p.x[i] - start);
+            self.scratch
+                .add_contact(p.x[i].z, branch, f, grid, kernel, area);
+            if wall_a || wall_o {
+                let w = if wall_a { a } else { o };
+                self.wall[b][usize::from(p.x[w].z > mid)] -= f;
+            }
+        }
+        let unit = &mut self.bins[b];
+        for (sum, s) in unit.sum.contact.iter_mut().zip(&self.scratch.contact) {
+            *sum += s;
+        }
+        unit.contact_samples += 1;
+        let core = core_range(&self.grid);
+        if self.trace.len() < TRACE_SAMPLES && !core.is_empty() {
+            let n = core.len() as f64;
+            let (mut pressure, mut shear) = (0.0, 0.0);
+            for k in core {
+                pressure += self.scratch.contact[k].trace() / 3.0;
+                shear += self.scratch.contact[k][(0, 2)];
+            }
+            self.trace.push([pressure / n, shear / n]);
+        }
+    }
+
+    /// Halves the number of bins: bins 2j and 2j + 1 become bin j, twice as long.
+    fn merge_neighbours(&mut self) {
+        let bins = std::mem::take(&mut self.bins);
+        let wall = std::mem::take(&mut self.wall);
+        for (pair, w) in bins.chunks(2).zip(wall.chunks(2)) {
+            let mut u = pair[0].clone();
+            let mut f = w[0];
+            if let (Some(second), Some(g)) = (pair.get(1), w.get(1)) {
+                u.merge(second);
+                f[0] += g[0];
+                f[1] += g[1];
+            }
+            self.bins.push(u);
+            self.wall.push(f);
+        }
+        self.bin_steps *= 2;
+    }
+
+    /// The profiles of the samples so far, with their per-field errors and the averaging
+    /// facts; `None` before the first sample of both the particles and the contacts.
+    pub fn result(&self) -> Option<InrunResult> {
+        let kept: Vec<usize> = (0..self.bins.len())
+            .filter(|&b| self.bins[b].particle_samples > 0 && self.bins[b].contact_samples > 0)
+            .collect();
+        if kept.is_empty() {
+            return None;
+        }
+        let units: Vec<Unit> = kept.iter().map(|&b| self.bins[b].clone()).collect();
+        let errors = blocking::field_errors(&units, &self.grid);
+        let blocks = blocking::common_blocks(&errors);
+        let all = blocking::merged(&units);
+        let col = |name: &str| COLUMNS.iter().position(|c| *c == name).expect("column");
+        let tau_energy = ["kin_xx", "kin_yy", "kin_zz"]
+            .iter()
+            .map(|c| errors.tau[col(c)])
+            .fold(f64::NAN, f64::max);
+        let profiles = Profiles {
+            grid: self.grid.clone(),
+            kernel: self.kernel,
+            saves: kept.iter().map(|&b| b as u64).collect(),
+            blocks,
+            mean: derive(&all.mean()),
+            block_columns: blocking::block_columns(&units, blocks),
+            se: errors.se.clone(),
+            per_save: units.iter().map(Unit::mean).collect(),
+            wall_force: kept
+                .iter()
+                .map(|&b| {
+                    let n = self.bins[b].contact_samples as f64;
+                    [self.wall[b][0] / n, self.wall[b][1] / n]
+                })
+                .collect(),
+            domain: self.domain.clone(),
+            free: self.free,
+            free_volume: self.free_volume,
+            tau_shear: errors.tau[col("shear_xz")],
+            tau_energy,
+        };
+        let trace_tau = |k: usize| {
+            let x: Vec<f64> = self.trace.iter().map(|t| t[k]).collect();
+            integrated_autocorrelation(&x)
+        };
+        Some(InrunResult {
+            sampling: self.sampling,
+            bin_steps: self.bin_steps,
+            contact_samples: all.contact_samples,
+            particle_samples: all.particle_samples,
+            contact_tau: [trace_tau(0), trace_tau(1)],
+            trace_len: self.trace.len(),
+            density: self.density,
+            profiles,
+            units,
+            errors,
+        })
+    }
+}
+
+impl Observer for Inrun {
+    fn next_after(&self, step: u64) -> Option<u64> {
+        let s = self.sampling;
+        let next = (step.max(s.from) / s.every + 1) * s.every;
+        (next <= s.to).then_some(next)
+    }
+
+    fn observe(&mut self, engine: &dyn Engine) {
+        let step = engine.state().step;
+        if step <= self.sampling.from || step > self.sampling.to {
+            return;
+        }
+        let particles = step.is_multiple_of(self.sampling.particle_every);
+        self.sample(&engine.snapshot(), particles);
+    }
+}
+
+/// In-run profiles and how they were averaged.
+#[derive(Clone, Debug)]
+pub struct InrunResult {
+    pub sampling: Sampling,
+    /// Steps per bin at the end.
+    pub bin_steps: u64,
+    pub contact_samples: u64,
+    pub particle_samples: u64,
+    /// Integrated autocorrelation time, in contact samples, of the core means of the contact
+    /// pressure [0] and contact σxz [1], over the first `trace_len` samples.
+    pub contact_tau: [f64; 2],
+    pub trace_len: usize,
+    /// Particle density (for the kinetic-theory check).
+    pub density: f64,
+    /// The profiles: `saves` holds bin numbers, `per_save` and `wall_force` the bins' means.
+    pub profiles: Profiles,
+    pub errors: FieldErrors,
+    /// The bins the profiles were averaged from.
+    pub units: Vec<Unit>,
+}
+
+/// Path of the in-run profiles of the run `name` in `dir`.
+pub fn csv_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.profiles_inrun.csv"))
+}
+
+/// The in-run profiles as CSV: the columns of `NAME.profiles.csv`.
+pub fn csv(r: &InrunResult) -> String {
+    Table::of(&r.profiles).csv()
+}
+
+/// The core mean of column `name` over `units` and its standard error from `blocks` blocks of
+/// them.
+fn core_mean(units: &[Unit], grid: &Grid, blocks: usize, name: &str) -> (f64, f64) {
+    let c = COLUMNS.iter().position(|x| *x == name).expect("column");
+    let core = core_range(grid);
+    let n = core.len() as f64;
+    let of = |d: &[Vec<f64>]| core.clone().map(|k| d[k][c]).sum::<f64>() / n;
+    let all: Vec<Vec<f64>> = derive(&blocking::merged(units).mean())
+        .iter()
+        .map(columns)
+        .collect();
+    let vals: Vec<f64> = blocking::block_columns(units, blocks)
+        .iter()
+        .map(|b| of(b))
+        .collect();
+    (of(&all), crate::analysis::stats::standard_error(&vals))
+}
+
+/// The in-run part of `checks.txt`: how the samples were taken, each field's autocorrelation
+/// time and blocks, the checks of the in-run profiles, and the core means of the pressure and
+/// shear stress beside those of the saves (`saves`, with the saves' own per-field errors
+/// `save_errors`), with the ratio of their standard errors.
+pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> String {
+    let s = r.sampling;
+    let p = &r.profiles;
+    let mut out = format!(
+        "\nin-run averaging: steps {}..{} (after {}), contact stress and wall forces every {} \
+         steps ({} samples), particle fields every {} steps ({} samples), {} bins of {} steps; \
+         autocorrelation time of the core contact stress over its first {} samples: {} \
+         samples (pressure), {} (shear)\n",
+        s.from + 1,
+        s.to,
+        s.from,
+        s.every,
+        r.contact_samples,
+        s.particle_every,
+        r.particle_samples,
+        p.saves.len(),
+        r.bin_steps,
+        r.trace_len,
+        blocking::shown(r.contact_tau[0]),
+        blocking::shown(r.contact_tau[1]),
+    );
+    out.push_str("per-field errors of the saves (tau in saves):\n");
+    out.push_str(&blocking::describe(save_errors, saves.saves.len(), "saves"));
+    out.push_str(&format!(
+        "per-field errors in-run (tau in bins of {} steps):\n",
+        r.bin_steps
+    ));
+    out.push_str(&blocking::describe(&r.errors, p.saves.len(), "bins"));
+    out.push_str("checks of the in-run profiles:\n");
+    let report = checks::report(p, &checks::run(p, r.density));
+    // The first line of the saves' report speaks of saves; the in-run one is above, and the
+    // in-run series is one of bins.
+    for line in report.lines().skip(1) {
+        out.push_str(&line.replace(" saves", " bins"));
+        out.push('\n');
+    }
+    out.push_str(
+        "core means, saves (block errors as profiles.csv) vs in-run (each field's own blocks), \
+         judged equal within 3 combined SE:\n",
+    );
+    if core_range(&p.grid).is_empty() {
+        return out;
+    }
+    let save_units: Vec<Unit> = saves.per_save.iter().cloned().map(Unit::of_save).collect();
+    for name in ["nu", "T", "pressure", "shear_xz", "con_xz", "con_zz"] {
+        let c = COLUMNS.iter().position(|x| *x == name).expect("column");
+        let (a, sa) = core_mean(&save_units, &saves.grid, saves.blocks, name);
+        let (b, sb) = core_mean(&r.units, &p.grid, r.errors.blocks[c], name);
+        let tol = 3.0 * (sa * sa + sb * sb).sqrt();
+        let verdict = Verdict::judge(
+            "",
+            name,
+            a - b,
+            Limit::Absolute {
+                expected: 0.0,
+                tolerance: tol,
+            },
+        )
+        .judged_if(saves.blocks >= 2 && p.blocks >= 2);
+        let shown = match verdict.pass() {
+            Some(true) => "PASS",
+            Some(false) => "FAIL",
+            None => "info",
+        };
+        let ratio = if sb > 0.0 {
+            format!("{:.1}", sa / sb)
+        } else {
+            "undefined".into()
+        };
+        out.push_str(&format!(
+            "{shown:4}  {name:9} saves {a:+.5} +- {sa:.2e}   in-run {b:+.5} +- {sb:.2e}   SE \
+             ratio {ratio}\n"
+        ));
+    }
+    out
+}

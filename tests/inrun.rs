@@ -1,0 +1,287 @@
+//! In-run averaging (`verdem run`'s NAME.profiles_inrun.csv): the same fields as the saves'
+//! coarse-graining when it samples the saves' steps, agreement within errors when it samples
+//! more often, the analytical stress of a static compressed lattice, and the files a run writes.
+
+mod common;
+
+use verdem::analysis::cg::{self, CgOptions, Series, COLUMNS};
+use verdem::analysis::inrun::{Inrun, Sampling};
+use verdem::analysis::stats::standard_error;
+use verdem::case::Case;
+use verdem::engine::Overrides;
+use verdem::run::{self, RunOptions};
+use verdem::step::Engine;
+
+fn col(name: &str) -> usize {
+    COLUMNS.iter().position(|c| *c == name).unwrap()
+}
+
+fn options(dir: &std::path::Path, end_step: u64, save_every: u64, saves: bool) -> RunOptions {
+    RunOptions {
+        end_step,
+        save_every,
+        checkpoint_every: 0,
+        out_dir: dir.to_path_buf(),
+        name: "s".into(),
+        tag: "s".into(),
+        progress: false,
+        write_saves: saves,
+        vtk: false,
+        stop: None,
+    }
+}
+
+/// The steady case from the full run's final state, on one thread.
+fn steady() -> (Case, Box<dyn Engine>) {
+    let case = Case::load(&common::root().join("cases/shear_flow_steady.toml")).unwrap();
+    let init = common::root().join("golden/full_run/shear_flow.final.data");
+    let e = common::engine(
+        &case,
+        Some(&init),
+        Overrides {
+            threads: Some(1),
+            ..Overrides::default()
+        },
+    );
+    (case, e)
+}
+
+/// Runs the steady case for `steps` steps with a save every `save_every` and an in-run
+/// accumulator sampling `every` / `particle_every` over the steps of saves `first..`; returns
+/// the saves' profiles (from save `first` on) and the in-run result.
+fn steady_run(
+    steps: u64,
+    save_every: u64,
+    first: u64,
+    every: u64,
+    particle_every: u64,
+) -> (cg::Profiles, verdem::analysis::inrun::InrunResult) {
+    let (case, mut e) = steady();
+    let dir = tempfile::tempdir().unwrap();
+    let o = CgOptions {
+        from: Some(first),
+        ..CgOptions::for_case(&case)
+    };
+    let mut inrun = Inrun::new(
+        &o,
+        &e.state().domain,
+        Sampling {
+            every,
+            particle_every,
+            // samples at the steps of saves first, first + 1, …
+            from: first * save_every - every,
+            to: steps,
+        },
+    )
+    .unwrap();
+    let opts = options(dir.path(), steps, save_every, true);
+    run::run_observed(e.as_mut(), &opts, false, Some(&mut inrun)).unwrap();
+    let saves = cg::coarse_grain(&Series::find(&dir.path().join("s")).unwrap(), &o).unwrap();
+    (saves, inrun.result().unwrap())
+}
+
+#[test]
+fn sampling_the_saves_steps_gives_the_saves_profiles() {
+    // Samples at exactly the saves' steps see the states the saves hold: every column equals
+    // the saves' coarse-graining up to the rounding of the .fstat forces' components.
+    let (saves, inrun) = steady_run(20_000, 1000, 10, 1000, 1000);
+    assert_eq!(inrun.contact_samples, 11);
+    assert_eq!(inrun.particle_samples, 11);
+    let a = &saves.mean;
+    let b = &inrun.profiles.mean;
+    for (c, name) in COLUMNS.iter().enumerate() {
+        let scale = a
+            .iter()
+            .map(|d| cg::columns(d)[c].abs())
+            .fold(0.0, f64::max);
+        for k in 0..a.len() {
+            let (x, y) = (cg::columns(&a[k])[c], cg::columns(&b[k])[c]);
+            assert!(
+                (x - y).abs() <= 1e-9 * scale,
+                "{name} at slice {k}: saves {x}, in-run {y}"
+            );
+        }
+    }
+    // and the wall forces per save equal the saves' .fstat rows
+    for (s, w) in saves.wall_force.iter().zip(&inrun.profiles.wall_force) {
+        for g in 0..2 {
+            assert!(
+                (s[g] - w[g]).norm() <= 1e-9 * s[g].norm().max(1.0),
+                "{s:?} {w:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sampling_every_half_contact_agrees_with_the_saves_within_errors_and_is_more_precise() {
+    // 20000 steps, saves 10..20 (11 saves) against contact samples every 25 steps over the same
+    // steps (particle samples at the saves' steps, so that the kinetic parts are the same).
+    let (saves, inrun) = steady_run(20_000, 1000, 10, 25, 1000);
+    let p = &inrun.profiles;
+    let core = cg::core_range(&saves.grid);
+    // Core means (per slice, 11 saves leave most slices with a contact in only a few saves,
+    // and their block errors say little).
+    let core_mean = |q: &cg::Profiles, c: usize| -> (f64, f64) {
+        let n = core.len() as f64;
+        let mean = core
+            .clone()
+            .map(|k| cg::columns(&q.mean[k])[c])
+            .sum::<f64>()
+            / n;
+        let vals: Vec<f64> = q
+            .block_columns
+            .iter()
+            .map(|b| core.clone().map(|k| b[k][c]).sum::<f64>() / n)
+            .collect();
+        (mean, standard_error(&vals))
+    };
+    for name in ["con_xz", "con_zz", "pressure", "shear_xz"] {
+        let ((a, sa), (b, sb)) = (core_mean(&saves, col(name)), core_mean(p, col(name)));
+        let z = (a - b) / (sa * sa + sb * sb).sqrt();
+        assert!(
+            z.abs() < 3.0,
+            "{name}: saves {a} +- {sa}, in-run {b} +- {sb}"
+        );
+    }
+    // Standard errors of the core mean of σxz: 11 saves against ~11000 steps / 2τ ≈ 280
+    // independent samples (τ ≈ 20 steps, docs/statistics.md): √(280/11) ≈ 5 times smaller.
+    let core_se = |q: &cg::Profiles| core_mean(q, col("con_xz")).1;
+    let ratio = core_se(&saves) / core_se(p);
+    assert!(ratio > 2.5, "SE ratio saves / in-run {ratio:.2}");
+}
+
+#[test]
+fn a_static_compressed_lattice_has_the_analytical_contact_stress() {
+    // A simple cubic lattice of 4×4×4 spheres of diameter 1 at spacing a = 0.99 in a periodic
+    // box, at rest: each sphere has six neighbours at overlap δ = 1 − a pressing equally from
+    // opposite sides, so nothing moves, and each contact carries f = kn·δ (no relative velocity,
+    // no damping force). The contact stress Σ f⊗l / V has one contact per sphere and direction:
+    // σ_xx = σ_yy = σ_zz = kn·δ·a / a³ = kn·δ/a², no shear; σ_zz is the same in every slice
+    // (the vertical branches tile each column), σ_xx and σ_yy hold only on average over the
+    // height (the horizontal branches lie in the layers' slices).
+    let (a, n, kn) = (0.99, 4usize, 2e5);
+    let l = a * n as f64;
+    let mut text = format!(
+        "name = \"lattice\"\n[run]\nsteps = 100\nsave_every = 100\nsteps_per_collision = 50.0\n\
+         threads = 1\n[domain]\nlo = [0.0, 0.0, 0.0]\nhi = [{l}, {l}, {l}]\n\
+         periodic = [true, true, true]\n[material]\ndensity = 1.0\ndiameter = 1.0\n\
+         [contact]\nkn = {kn}\ngamman = 15.0\nkt = 0.0\ngammat = 0.0\nmu = 0.0\n\
+         [scene]\nkind = \"spheres\"\n"
+    );
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let at = |q: usize| (q as f64 + 0.5) * a;
+                text.push_str(&format!(
+                    "[[scene.sphere]]\nx = [{}, {}, {}]\nv = [0.0, 0.0, 0.0]\n",
+                    at(i),
+                    at(j),
+                    at(k)
+                ));
+            }
+        }
+    }
+    let case = Case::parse(&text, "lattice.toml").unwrap();
+    let mut e = common::engine(&case, None, Overrides::default());
+    let slices = 36; // h = 0.11: the layers' centres fall inside slices
+    let o = CgOptions {
+        slices,
+        walls: 0,
+        periodic: [true; 3],
+        ..CgOptions::default()
+    };
+    let mut inrun = Inrun::new(
+        &o,
+        &e.state().domain,
+        Sampling {
+            every: 5,
+            particle_every: 10,
+            from: 0,
+            to: 100,
+        },
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    run::run_observed(
+        e.as_mut(),
+        &options(dir.path(), 100, 100, false),
+        false,
+        Some(&mut inrun),
+    )
+    .unwrap();
+    let r = inrun.result().unwrap();
+    assert_eq!(r.contact_samples, 20);
+    let expected = kn * (1.0 - a) / (a * a);
+    let p = &r.profiles;
+    let height_mean = |name: &str| {
+        let c = col(name);
+        p.mean.iter().map(|d| cg::columns(d)[c]).sum::<f64>() / slices as f64
+    };
+    for name in ["con_xx", "con_yy"] {
+        let m = height_mean(name);
+        assert!(
+            (m / expected - 1.0).abs() < 1e-9,
+            "{name}: {m} vs {expected}"
+        );
+    }
+    for name in ["con_xy", "con_xz", "con_yz", "shear_xz", "kin_zz"] {
+        let m = height_mean(name);
+        assert!(m.abs() < 1e-9 * expected, "{name}: {m}");
+    }
+    // z is bounded in the coarse-graining (walls in the benchmark): the branches that cross
+    // the periodic z boundary are spread inside the box only, so σzz is checked between the
+    // lowest and the highest layer's centres, which every column's branches tile.
+    let h = l / slices as f64;
+    let inside = (0..slices).filter(|&k| {
+        let z = p.grid.z(k);
+        z - h / 2.0 >= 0.5 * a && z + h / 2.0 <= (n as f64 - 0.5) * a
+    });
+    assert_eq!(inside.clone().count(), 26);
+    for k in inside {
+        let zz = cg::columns(&p.mean[k])[col("con_zz")];
+        assert!(
+            (zz / expected - 1.0).abs() < 1e-9,
+            "con_zz at slice {k}: {zz}"
+        );
+    }
+}
+
+#[test]
+fn a_run_writes_its_in_run_profiles_and_judges_them_beside_the_saves() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("q");
+    common::verdem_ok([
+        "run",
+        "cases/shear_flow_quick.toml",
+        "--steps",
+        "4000",
+        "--save-every",
+        "1000",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let name = "shear_flow_quick";
+    let table = cg::table::Table::read(&out.join(format!("{name}.profiles_inrun.csv"))).unwrap();
+    let saves = cg::table::Table::read(&out.join(format!("{name}.profiles.csv"))).unwrap();
+    assert_eq!(table.z, saves.z);
+    let checks = std::fs::read_to_string(out.join(format!("{name}.checks.txt"))).unwrap();
+    assert!(
+        checks.contains("in-run averaging: steps 3001..4000"),
+        "{checks}"
+    );
+    assert!(checks.contains("every 400 steps (3 samples)"), "{checks}");
+    assert!(
+        checks.contains("checks of the in-run profiles:"),
+        "{checks}"
+    );
+    assert!(checks.contains("SE ratio"), "{checks}");
+    // 3 contact samples in one bin: no autocorrelation time, and no NaN written for it
+    assert!(
+        checks.contains("samples: undefined samples (pressure)"),
+        "{checks}"
+    );
+    let mut words = checks.split(|c: char| !c.is_alphanumeric());
+    assert!(!words.any(|w| w == "NaN" || w == "inf"), "{checks}");
+}
