@@ -118,6 +118,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let engine = if a.merge {
         "merge"
     } else {
+        plan.check()?;
         plan.claim(&case.name, a.force)?;
         let cmd = replica_command(&plan)?;
         let outcomes = match a.engine {

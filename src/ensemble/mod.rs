@@ -161,6 +161,18 @@ impl Plan {
         Ok(Case::load(&self.case)?.name)
     }
 
+    /// Builds replica 0's start (the case, its initial state, the perturbation), so that bad
+    /// input is reported once, before any replica is started or submitted.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let case = Case::load(&self.case)?;
+        let mut start = scene::build(&case, self.init.as_deref())?;
+        perturb(
+            &mut start.particles,
+            self.perturbation,
+            replica_seed(self.base_seed, 0),
+        )
+    }
+
     /// Runs replica `k` on one thread into [`replica_dir`], replacing an earlier run of it
     /// there: the case's initial state, perturbed with [`replica_seed`]`(base_seed, k)`, run to
     /// the end step with saves, its summary, its coarse-grained profiles ([`cg::write_all`],
