@@ -407,6 +407,13 @@ impl Merged {
             self.records.first().map_or(0, |r| r.saves),
             self.blocks
         );
+        if self.blocks < 2 {
+            let _ = writeln!(
+                s,
+                "the replicas' profiles come from one block of saves and have no block errors: \
+                 the coverage test needs more saves per replica (--every)"
+            );
+        }
         let _ = writeln!(
             s,
             "{:<9} {:>13} {:>11} {:>9} {:>9} {:>14}",
