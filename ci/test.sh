@@ -16,6 +16,16 @@ if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command 
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts openmpi-bin yade fonts-dejavu-core python3-paraview >/dev/null
 fi
 
+echo "== Slurm (a one-node cluster on localhost for tests/ensemble.rs)"
+# Debian's slurm-wlm and munge; ci/slurm_local.sh configures and starts munged, slurmctld and
+# slurmd (quick when they already run). The Slurm tests run, and must pass, with VERDEM_SLURM=1.
+if ! command -v sbatch >/dev/null || ! command -v slurmd >/dev/null || ! command -v munged >/dev/null; then
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
+fi
+bash ci/slurm_local.sh
+export VERDEM_SLURM=1
+
 echo "== Python packages (virtual environment target/venv)"
 # Kratos DEM (a peer) and meshio (an independent VTK reader), pinned in ci/requirements.txt.
 # The tests find this Python through VERDEM_PYTHON.

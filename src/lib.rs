@@ -10,6 +10,7 @@ pub mod bench;
 pub mod case;
 pub mod contact;
 pub mod engine;
+pub mod ensemble;
 pub mod io;
 pub mod kinematics;
 pub mod neighbor;

@@ -50,6 +50,10 @@ enum Command {
     /// The stability map: dt, stiffness, speed, damping, friction and packing at their
     /// extremes, each row with theory, measurement, what verdem did and a verdict.
     Extremes(cli::extremes::Args),
+    /// Run R independent replicas of a case (seeded velocity perturbations of its start) on
+    /// this machine or as a Slurm job array, and merge their profiles with ensemble error bars
+    /// and the coverage test of the replicas' own error bars.
+    Ensemble(cli::ensemble::Args),
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash(cli::hash::Args),
     /// Convert a MercuryCG series (verdem's or a peer's) into ParaView files: NAME.NNNN.vtu per
@@ -68,6 +72,7 @@ fn main() {
         Command::Peers(a) => cli::peers::exec(a),
         Command::Tradeoff(a) => cli::tradeoff::exec(a),
         Command::Kinematics(a) => cli::kinematics::exec(a),
+        Command::Ensemble(a) => cli::ensemble::exec(a),
         Command::Hash(a) => cli::hash::exec(a),
         Command::Vtk(a) => cli::vtk::exec(a),
         Command::Extremes(a) => cli::extremes::exec(a),

@@ -1,10 +1,12 @@
 //! Judging results: the statistics the reports share ([`stats`]), the one verdict type that
 //! the verification table, the profile checks, the timing goals and the cross-runs report
 //! ([`verdict`]), coarse-graining of saves into profiles with their checks ([`cg`]), and the
-//! speed/accuracy trade of the shear case ([`tradeoff`]), a picture of a save's particles
+//! speed/accuracy trade of the shear case ([`tradeoff`]), the merge of an ensemble's profiles
+//! ([`ensemble`]), a picture of a save's particles
 //! ([`particles`]).
 
 pub mod cg;
+pub mod ensemble;
 pub mod inrun;
 pub mod particles;
 pub mod stats;

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod cg;
 pub mod compare;
 pub mod cross;
+pub mod ensemble;
 pub mod extremes;
 pub mod hash;
 pub mod kinematics;
