@@ -1,0 +1,280 @@
+//! Prescribed motions in the real LAMMPS and LIGGGHTS: the same two-sphere motions that
+//! [`crate::kinematics::drive`] runs through verdem's laws, run through the peers' own contact
+//! laws, in process, through their C library interfaces ([`library`], loaded at run time).
+//!
+//! The input is the one the peers' cross-runs and binary collisions use
+//! ([`lammps_family::Dialect::setup_and_law`]: LAMMPS `pair_style granular` hooke /
+//! `linear_history` / `damping velocity`, LIGGGHTS `gran model hooke/stiffness tangential
+//! history absolute_damping on`), read from a data file of the case's two spheres in a
+//! non-periodic box that holds every row of the motion, with no time integration fix: nothing
+//! moves the atoms but this driver. Per row it sets both spheres' positions, velocities and
+//! spins (orientations: a sphere's force does not depend on them), then lets the code evaluate
+//! its forces, and reads the forces and torques back:
+//!
+//! - row 0: `run 0`, the set-up force evaluation. Both codes skip the tangential history
+//!   update there (LAMMPS `src/GRANULAR/pair_granular.cpp`, `PairGranular::compute`:
+//!   `if (update->setupflag) history_update = 0`; LIGGGHTS `tangential_model_history.h`:
+//!   `if (sidata.shearupdate && sidata.computeflag)`, with `shearupdate` false during set-up),
+//!   which is verdem's row 0: the row's own velocities, no increment.
+//! - row k ≥ 1: `timestep` set to t_k − t_(k−1) where it changed, then `run 1 pre no post no`:
+//!   one step of `Verlet::run`, whose force evaluation advances the history by the velocities
+//!   set times dt (so `run 0` would not do: it never advances it), with the neighbour list
+//!   rebuilt every step (`neigh_modify every 1 delay 0 check no`; the history follows the pair
+//!   across rebuilds). The velocities are the step averages of [`Increment`], as verdem's.
+//!
+//! Sphere 1 is atom 1 (i), sphere 2 atom 2 (j); forces and torques are each atom's `f` and
+//! `torque` after the step; the overlap, the signed normal force (the force on sphere 2 along n
+//! from 1 to 2) and the tangential magnitude are formed as in [`crate::kinematics`]. The case
+//! gives the radii, the density and kn, gamman, kt, gammat, mu; its `tangential` and
+//! `clip_normal` are the peer's own (its [`MotionPeer::convention`], not clipped).
+
+pub mod library;
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use anyhow::{ensure, Context};
+
+use self::library::{Flavour, Instance};
+use super::lammps::Lammps;
+use super::lammps_family::{data_file, Dialect};
+use super::liggghts::Liggghts;
+use crate::case::{Case, Scene, Tangential};
+use crate::kinematics::{pair_of, ForceRow, Increment, MotionRow};
+use crate::state::Snapshot;
+use crate::Vec3;
+
+/// A peer whose contact law can be driven through a prescribed motion in process.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MotionPeer {
+    Lammps,
+    Liggghts,
+}
+
+impl MotionPeer {
+    /// Every such peer.
+    pub const ALL: [MotionPeer; 2] = [MotionPeer::Lammps, MotionPeer::Liggghts];
+
+    /// Its name on the command line (that of the peer in [`super::all`]).
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionPeer::Lammps => Lammps::NAME,
+            MotionPeer::Liggghts => Liggghts::NAME,
+        }
+    }
+
+    /// One line saying which library and contact law (for help texts).
+    pub fn description(self) -> &'static str {
+        match self {
+            MotionPeer::Lammps => {
+                "LAMMPS' library (liblammps.so.0), pair_style granular hooke linear_history"
+            }
+            MotionPeer::Liggghts => {
+                "LIGGGHTS' library (libliggghts.so.3), gran model hooke/stiffness tangential history"
+            }
+        }
+    }
+
+    /// The peer called `name`, if it can be driven so.
+    pub fn named(name: &str) -> Option<MotionPeer> {
+        MotionPeer::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// The verdem convention that re-implements its contact law.
+    pub fn convention(self) -> Tangential {
+        match self {
+            MotionPeer::Lammps => Lammps::CONVENTION,
+            MotionPeer::Liggghts => Liggghts::CONVENTION,
+        }
+    }
+
+    fn flavour(self) -> Flavour {
+        match self {
+            MotionPeer::Lammps => Flavour::Lammps,
+            MotionPeer::Liggghts => Flavour::Liggghts,
+        }
+    }
+
+    fn setup_and_law(self, case: &Case, data: &str) -> String {
+        match self {
+            MotionPeer::Lammps => Lammps::setup_and_law(case, data),
+            MotionPeer::Liggghts => Liggghts::setup_and_law(case, data),
+        }
+    }
+
+    /// Loads its library: an error saying how to install it when it is absent.
+    pub fn load(self) -> anyhow::Result<()> {
+        library::api(self.flavour()).map(|_| ())
+    }
+}
+
+/// One library instance at a time in the process (they share MPI's world and process state).
+static RUNNING: Mutex<()> = Mutex::new(());
+
+/// The step-average velocities of both spheres and the step of row `k` (row 0: its own
+/// velocities and no step), as [`crate::kinematics::drive`] takes them.
+fn step_velocities(
+    rows: &[MotionRow],
+    k: usize,
+    increment: Increment,
+) -> ([Vec3; 2], [Vec3; 2], f64) {
+    let row = &rows[k];
+    if k == 0 {
+        return (row.v, row.w, 0.0);
+    }
+    let prev = &rows[k - 1];
+    let dt = row.t - prev.t;
+    match increment {
+        Increment::Positions => {
+            let spin = |s: usize| (row.q[s] * prev.q[s].inverse()).scaled_axis() / dt;
+            (
+                [(row.x[0] - prev.x[0]) / dt, (row.x[1] - prev.x[1]) / dt],
+                [spin(0), spin(1)],
+                dt,
+            )
+        }
+        Increment::Trapezoid => {
+            let mean = |a: [Vec3; 2], b: [Vec3; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+            (mean(prev.v, row.v), mean(prev.w, row.w), dt)
+        }
+    }
+}
+
+/// `case` with its two spheres free, at rest at row 0's positions, in a non-periodic box that
+/// holds both spheres' whole path with a margin of a diameter plus the neighbour skin.
+fn peer_case(case: &Case, motion: &[MotionRow], radius: [f64; 2]) -> anyhow::Result<Case> {
+    let mut c = case.clone();
+    let margin = 2.0 * radius[0].max(radius[1]) + case.neighbor.skin;
+    for row in motion {
+        for x in row.x {
+            for k in 0..3 {
+                c.domain.lo[k] = c.domain.lo[k].min(x[k] - margin);
+                c.domain.hi[k] = c.domain.hi[k].max(x[k] + margin);
+            }
+        }
+    }
+    c.domain.periodic = [false; 3];
+    let Scene::Spheres { sphere } = &mut c.scene else {
+        anyhow::bail!("{}: needs a spheres scene", case.path.display());
+    };
+    for (s, x) in sphere.iter_mut().zip(motion[0].x) {
+        s.x = x.into();
+        s.v = [0.0; 3];
+        s.w = [0.0; 3];
+        s.fixed = false;
+    }
+    Ok(c)
+}
+
+/// A folder of its own under the system's temporary folder, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new() -> anyhow::Result<TempDir> {
+        static COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("verdem-motion-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&dir).with_context(|| dir.display().to_string())?;
+        Ok(TempDir(dir))
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Drives one contact of `case`'s two spheres through `motion` in `peer`'s library, with the
+/// increments of `increment`: the forces and torques at every row, with the semantics of
+/// [`crate::kinematics::drive`] (module doc). Times and lengths in the case's units.
+pub fn drive(
+    peer: MotionPeer,
+    case: &Case,
+    motion: &[MotionRow],
+    increment: Increment,
+) -> anyhow::Result<Vec<ForceRow>> {
+    ensure!(!motion.is_empty(), "a motion of no rows");
+    let (_, radius) = pair_of(case)?;
+    let placed = peer_case(case, motion, radius)?;
+    let scene = crate::scene::build(&placed, None)?;
+    let state = Snapshot {
+        step: 0,
+        time: 0.0,
+        domain: scene.domain,
+        particles: scene.particles,
+        contacts: Vec::new(),
+    };
+    let api = library::api(peer.flavour())?;
+    let dir = TempDir::new()?;
+    let data = dir.0.join("pair.data");
+    std::fs::write(&data, data_file(&state, case.material.density))
+        .with_context(|| data.display().to_string())?;
+    let data = data.display().to_string();
+    ensure!(
+        !data.contains(char::is_whitespace),
+        "the temporary folder {data} has a space in its path, which the peers' read_data cannot take"
+    );
+    let first_dt = motion.get(1).map_or(case.dt(), |r| r.t - motion[0].t);
+
+    let _running = RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+    let mut lmp = Instance::open(api)?;
+    lmp.script(&peer.setup_and_law(&placed, &data))?;
+    // a full rebuild of the neighbour list every step, whatever the atoms moved
+    lmp.command("neigh_modify    delay 0 every 1 check no")?;
+    lmp.command(&format!("timestep        {first_dt:?}"))?;
+    let mut dt_now = first_dt;
+    ensure!(
+        lmp.nlocal()? == 2,
+        "{}: {} atoms read, 2 expected",
+        peer.name(),
+        lmp.nlocal()?
+    );
+
+    let mut out = Vec::with_capacity(motion.len());
+    for (k, row) in motion.iter().enumerate() {
+        let (v, w, dt) = step_velocities(motion, k, increment);
+        if k > 0 && dt != dt_now {
+            lmp.command(&format!("timestep {dt:?}"))?;
+            dt_now = dt;
+        }
+        let local = local_indices(&lmp)?;
+        for s in 0..2 {
+            lmp.set("x", local[s], row.x[s].into())?;
+            lmp.set("v", local[s], v[s].into())?;
+            lmp.set("omega", local[s], w[s].into())?;
+        }
+        lmp.command(if k == 0 {
+            "run 0 post no"
+        } else {
+            "run 1 pre no post no"
+        })?;
+        let local = local_indices(&lmp)?;
+        let read = |name: &str, s: usize| lmp.get(name, local[s]).map(Vec3::from);
+        let f = [read("f", 0)?, read("f", 1)?];
+        let torque = [read("torque", 0)?, read("torque", 1)?];
+        let r = row.x[1] - row.x[0];
+        let n = r.normalize();
+        let fn_signed = f[1].dot(&n);
+        out.push(ForceRow {
+            t: row.t,
+            f,
+            torque,
+            delta: radius[0] + radius[1] - r.norm(),
+            fn_signed,
+            ft: (f[1] - fn_signed * n).norm(),
+        });
+    }
+    Ok(out)
+}
+
+/// The local indices of atoms 1 and 2 (a code may reorder its atoms when it sorts them).
+fn local_indices(lmp: &Instance) -> anyhow::Result<[usize; 2]> {
+    let tags = lmp.tags()?;
+    let find = |id: i32| {
+        tags.iter()
+            .position(|&t| t == id)
+            .with_context(|| format!("atom {id} is gone (ids {tags:?})"))
+    };
+    Ok([find(1)?, find(2)?])
+}
