@@ -218,8 +218,21 @@ pub fn drive(
     let first_dt = motion.get(1).map_or(case.dt(), |r| r.t - motion[0].t);
 
     let _running = RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+    let script = peer.setup_and_law(&placed, &data);
+    // a number the code cannot read would end the process (library::Instance::command)
+    if let Some(line) = script.lines().find(|l| {
+        l.split_whitespace()
+            .any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite()))
+    }) {
+        anyhow::bail!(
+            "{}: the case's law has no finite {} input: `{line}` (LAMMPS' tangential damping is \
+             relative to the normal one: gammat needs gamman > 0)",
+            case.path.display(),
+            peer.name()
+        );
+    }
     let mut lmp = Instance::open(api)?;
-    lmp.script(&peer.setup_and_law(&placed, &data))?;
+    lmp.script(&script)?;
     // a full rebuild of the neighbour list every step, whatever the atoms moved
     lmp.command("neigh_modify    delay 0 every 1 check no")?;
     lmp.command(&format!("timestep        {first_dt:?}"))?;
