@@ -10,7 +10,7 @@ echo "== system packages"
 # module (python3-paraview), whose reader opens a run's VTK files in tests/vtk.rs; the LAMMPS and
 # LIGGGHTS libraries (liblammps0, libliggghts3) that tests/peer_motion.rs drives in process.
 if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command -v mpirun >/dev/null \
-   || ! ldconfig -p | grep -q "liblammps.so.0 " || ! ldconfig -p | grep -q "libliggghts.so.3 " \
+   || ! ldconfig -p | grep "liblammps.so.0 " >/dev/null || ! ldconfig -p | grep "libliggghts.so.3 " >/dev/null \
    || ! command -v yade >/dev/null \
    || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] \
    || [ ! -f /usr/lib/python3/dist-packages/paraview/simple.py ]; then
