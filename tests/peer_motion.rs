@@ -442,3 +442,50 @@ fn a_law_lammps_cannot_express_is_refused() {
     );
     assert!(e.contains("gammat needs gamman > 0"), "{e}");
 }
+
+/// Rows unevenly spaced in time: each step of the library is the rows' spacing (a time step
+/// the code did not take would scale the spring's increments, velocity times its dt, away from
+/// the rows' displacements).
+#[test]
+fn the_peers_time_step_is_the_rows_spacing() {
+    for peer in MotionPeer::ALL {
+        if !loaded(peer) {
+            continue;
+        }
+        let case = case_of(peer);
+        let (x, _) = kinematics::pair_of(&case).unwrap();
+        let mut rows = vec![MotionRow {
+            t: 0.0,
+            x,
+            q: [UnitQuaternion::identity(); 2],
+            v: [Vec3::zeros(); 2],
+            w: [Vec3::zeros(); 2],
+        }];
+        // sphere 2 slides along x at 0.05, in steps of 1e-4 and 3e-4 alternately
+        for k in 1..=40 {
+            let mut row = rows[k - 1];
+            row.t += if k % 2 == 0 { 1e-4 } else { 3e-4 };
+            row.x[1].x = 0.05 * row.t;
+            row.v[1].x = 0.05;
+            rows.push(row);
+        }
+        let real = motion::drive(peer, &case, &rows, Increment::Positions).unwrap();
+        let ours = verdem(&case, &rows);
+        for k in 0..6 {
+            eprintln!("{peer:?} {k} {} {}", real[k].ft, ours[k].ft);
+        }
+        let d = difference(&real, &ours);
+        assert!(d <= bound(rows.len()), "{peer:?}: {d:e}");
+        // the spring carries the whole slide, kt·0.05·t at the end (below the sliding limit),
+        // plus the dashpot's gammat·0.05; the slide tilts the normal by 4e-4 rad, whose
+        // projections take a part of order 1e-7 off
+        let end = real.last().unwrap();
+        let spring = case.contact.kt * 0.05 * end.t;
+        assert!(spring < case.contact.mu * end.fn_signed);
+        assert!(
+            (end.ft - (spring + case.contact.gammat * 0.05)).abs() < 1e-6 * spring,
+            "{peer:?}: {} vs {spring}",
+            end.ft
+        );
+    }
+}

@@ -16,11 +16,14 @@
 //!   `if (update->setupflag) history_update = 0`; LIGGGHTS `tangential_model_history.h`:
 //!   `if (sidata.shearupdate && sidata.computeflag)`, with `shearupdate` false during set-up),
 //!   which is verdem's row 0: the row's own velocities, no increment.
-//! - row k ≥ 1: `timestep` set to t_k − t_(k−1) where it changed, then `run 1 pre no post no`:
-//!   one step of `Verlet::run`, whose force evaluation advances the history by the velocities
-//!   set times dt (so `run 0` would not do: it never advances it), with the neighbour list
-//!   rebuilt every step (`neigh_modify every 1 delay 0 check no`; the history follows the pair
-//!   across rebuilds). The velocities are the step averages of [`Increment`], as verdem's.
+//! - row k ≥ 1: `run 1 pre no post no`: one step of `Verlet::run`, whose force evaluation
+//!   advances the history by the velocities set times dt (so `run 0` would not do: it never
+//!   advances it), with the neighbour list rebuilt every step (`neigh_modify every 1 delay 0
+//!   check no`; the history follows the pair across rebuilds). The velocities are the step
+//!   averages of [`Increment`], as verdem's. The code's dt is the rows' spacing t_k − t_(k−1):
+//!   where the spacing changes (beyond the rounding of the times, [`SAME_STEP`]) a `timestep`
+//!   command and a run with its set-up (`run 1 post no`), since LAMMPS' pair keeps its own
+//!   copy of dt.
 //!
 //! Sphere 1 is atom 1 (i), sphere 2 atom 2 (j); forces and torques are each atom's `f` and
 //! `torque` after the step; the overlap, the signed normal force (the force on sphere 2 along n
@@ -107,6 +110,12 @@ impl MotionPeer {
         library::api(self.flavour()).map(|_| ())
     }
 }
+
+/// Row spacings closer than this, relative, are one time step: they differ by the rounding of
+/// the rows' times (t/dt·ε ≈ 1e-11 after 1e5 rows), and a new step size costs a run's set-up.
+/// The velocities are scaled by the spacing over the code's step, so that the code's increment
+/// is the row's; its dashpots then see velocities off by as much, relative.
+const SAME_STEP: f64 = 1e-9;
 
 /// One library instance at a time in the process (they share MPI's world and process state).
 static RUNNING: Mutex<()> = Mutex::new(());
@@ -246,10 +255,20 @@ pub fn drive(
 
     let mut out = Vec::with_capacity(motion.len());
     for (k, row) in motion.iter().enumerate() {
-        let (v, w, dt) = step_velocities(motion, k, increment);
-        if k > 0 && dt != dt_now {
-            lmp.command(&format!("timestep {dt:?}"))?;
-            dt_now = dt;
+        let (mut v, mut w, dt) = step_velocities(motion, k, increment);
+        let mut run = "run 1 pre no post no";
+        if k > 0 {
+            if (dt - dt_now).abs() > SAME_STEP * dt_now {
+                // LAMMPS 20220106's `timestep` sets only `update->dt`; pair granular keeps the
+                // copy `PairGranular::init_style` took: a new step size needs a set-up run
+                lmp.command(&format!("timestep {dt:?}"))?;
+                dt_now = dt;
+                run = "run 1 post no";
+            }
+            // the code's increment is velocity × its own step: that of the row
+            let scale = dt / dt_now;
+            v = v.map(|x| x * scale);
+            w = w.map(|x| x * scale);
         }
         let local = local_indices(&lmp)?;
         for s in 0..2 {
@@ -257,11 +276,7 @@ pub fn drive(
             lmp.set("v", local[s], v[s].into())?;
             lmp.set("omega", local[s], w[s].into())?;
         }
-        lmp.command(if k == 0 {
-            "run 0 post no"
-        } else {
-            "run 1 pre no post no"
-        })?;
+        lmp.command(if k == 0 { "run 0 post no" } else { run })?;
         let local = local_indices(&lmp)?;
         let read = |name: &str, s: usize| lmp.get(name, local[s]).map(Vec3::from);
         let f = [read("f", 0)?, read("f", 1)?];
