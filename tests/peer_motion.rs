@@ -489,3 +489,56 @@ fn the_peers_time_step_is_the_rows_spacing() {
         );
     }
 }
+
+/// A contact that opens and closes again: both codes forget the spring when the spheres part,
+/// as verdem's driver does, and start a new one when they touch again.
+#[test]
+fn the_peers_forget_the_spring_when_the_contact_opens() {
+    for peer in MotionPeer::ALL {
+        if !loaded(peer) {
+            continue;
+        }
+        let case = case_of(peer);
+        let (x, _) = kinematics::pair_of(&case).unwrap();
+        let dt = case.dt();
+        let mut rows = vec![MotionRow {
+            t: 0.0,
+            x,
+            q: [UnitQuaternion::identity(); 2],
+            v: [Vec3::zeros(); 2],
+            w: [Vec3::zeros(); 2],
+        }];
+        // slide sphere 2 along x, lift it 3e-3 along z (a gap of 2e-3), bring it back, slide on
+        let mut step = |d: Vec3, n: usize| {
+            for _ in 0..n {
+                let mut row = *rows.last().unwrap();
+                row.t += dt;
+                row.x[1] += d;
+                row.v[1] = d / dt;
+                rows.push(row);
+            }
+        };
+        step(Vec3::new(1e-5, 0.0, 0.0), 20);
+        step(Vec3::new(0.0, 0.0, 1e-4), 30);
+        step(Vec3::new(0.0, 0.0, -1e-4), 30);
+        step(Vec3::new(1e-5, 0.0, 0.0), 20);
+        let real = motion::drive(peer, &case, &rows, Increment::Positions).unwrap();
+        let ours = verdem(&case, &rows);
+        let d = difference(&real, &ours);
+        assert!(d <= bound(rows.len()), "{peer:?}: {d:e}");
+        assert!(real
+            .iter()
+            .any(|r| r.delta < 0.0 && r.ft == 0.0 && r.fn_signed == 0.0));
+        // after the gap the spring starts from zero: the last slide's 20 steps of 1e-5, plus
+        // the 10 steps of the approach in contact, whose 1e-4 along z have a tangential part
+        // 1e-4·2e-4 each (the normal is tilted by the first slide, 2e-4); the normal dashpot
+        // adds below 1e-4 of it
+        let end = real.last().unwrap();
+        let spring = case.contact.kt * (20.0 * 1e-5 + 10.0 * 1e-4 * 2e-4);
+        assert!(
+            (end.ft - (spring + case.contact.gammat * 1e-5 / dt)).abs() < 1e-4 * spring,
+            "{peer:?}: {} vs {spring}",
+            end.ft
+        );
+    }
+}
