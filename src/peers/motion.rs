@@ -40,7 +40,7 @@ use anyhow::{ensure, Context};
 
 use self::library::{Flavour, Instance};
 use super::lammps::Lammps;
-use super::lammps_family::{data_file, Dialect};
+use super::lammps_family::{boundary, data_file, neighbor, Dialect, GROUPS};
 use super::liggghts::Liggghts;
 use crate::case::{Case, Scene, Tangential};
 use crate::kinematics::{pair_of, ForceRow, Increment, MotionRow};
@@ -51,17 +51,24 @@ use crate::Vec3;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MotionPeer {
     Lammps,
+    /// LAMMPS with the classic `pair_style gran/hooke/history` (not a peer of the cross-runs).
+    LammpsHookeHistory,
     Liggghts,
 }
 
 impl MotionPeer {
     /// Every such peer.
-    pub const ALL: [MotionPeer; 2] = [MotionPeer::Lammps, MotionPeer::Liggghts];
+    pub const ALL: [MotionPeer; 3] = [
+        MotionPeer::Lammps,
+        MotionPeer::LammpsHookeHistory,
+        MotionPeer::Liggghts,
+    ];
 
     /// Its name on the command line (that of the peer in [`super::all`]).
     pub fn name(self) -> &'static str {
         match self {
             MotionPeer::Lammps => Lammps::NAME,
+            MotionPeer::LammpsHookeHistory => "lammps-hooke-history",
             MotionPeer::Liggghts => Liggghts::NAME,
         }
     }
@@ -71,6 +78,9 @@ impl MotionPeer {
         match self {
             MotionPeer::Lammps => {
                 "LAMMPS' library (liblammps.so.0), pair_style granular hooke linear_history"
+            }
+            MotionPeer::LammpsHookeHistory => {
+                "LAMMPS' library (liblammps.so.0), pair_style gran/hooke/history"
             }
             MotionPeer::Liggghts => {
                 "LIGGGHTS' library (libliggghts.so.3), gran model hooke/stiffness tangential history"
@@ -87,13 +97,14 @@ impl MotionPeer {
     pub fn convention(self) -> Tangential {
         match self {
             MotionPeer::Lammps => Lammps::CONVENTION,
+            MotionPeer::LammpsHookeHistory => Tangential::LammpsHookeHistory,
             MotionPeer::Liggghts => Liggghts::CONVENTION,
         }
     }
 
     fn flavour(self) -> Flavour {
         match self {
-            MotionPeer::Lammps => Flavour::Lammps,
+            MotionPeer::Lammps | MotionPeer::LammpsHookeHistory => Flavour::Lammps,
             MotionPeer::Liggghts => Flavour::Liggghts,
         }
     }
@@ -101,6 +112,7 @@ impl MotionPeer {
     fn setup_and_law(self, case: &Case, data: &str) -> String {
         match self {
             MotionPeer::Lammps => Lammps::setup_and_law(case, data),
+            MotionPeer::LammpsHookeHistory => hooke_history(case, data),
             MotionPeer::Liggghts => Liggghts::setup_and_law(case, data),
         }
     }
@@ -109,6 +121,35 @@ impl MotionPeer {
     pub fn load(self) -> anyhow::Result<()> {
         library::api(self.flavour()).map(|_| ())
     }
+}
+
+/// LAMMPS' set-up for `pair_style gran/hooke/history`, whose dashpots are γ·meff·v with
+/// meff = m1 m2/(m1 + m2) (`src/GRANULAR/pair_gran_hooke_history.cpp`): verdem's absolute
+/// dashpots γ become γ/meff of the case's two spheres (masses 4π/3 r³ ρ, as LAMMPS' `read_data`
+/// sets them for `atom_style sphere`); `dampflag` 1 keeps the tangential dashpot.
+fn hooke_history(case: &Case, data: &str) -> String {
+    let c = &case.contact;
+    let mass = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * r * r * r * case.material.density;
+    let [m1, m2] = pair_of(case).map_or([f64::NAN; 2], |(_, r)| r.map(mass));
+    let meff = m1 * m2 / (m1 + m2);
+    format!(
+        "units           lj\n\
+atom_style      sphere\n\
+boundary        {}\n\
+comm_modify     vel yes\n\
+read_data       {data}\n\
+{GROUPS}# dashpots gamma/meff with meff = {meff:?}: gran/hooke/history multiplies them by meff\n\
+pair_style      gran/hooke/history {:?} {:?} {:?} {:?} {:?} 1\n\
+pair_coeff      * *\n\
+{}",
+        boundary(case),
+        c.kn,
+        c.kt,
+        c.gamman / meff,
+        c.gammat / meff,
+        c.mu,
+        neighbor(case, ""),
+    )
 }
 
 /// Row spacings closer than this, relative, are one time step: they differ by the rounding of
