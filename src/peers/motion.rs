@@ -13,7 +13,8 @@
 //!
 //! - row 0: `run 0`, the set-up force evaluation. Both codes skip the tangential history
 //!   update there (LAMMPS `src/GRANULAR/pair_granular.cpp`, `PairGranular::compute`:
-//!   `if (update->setupflag) history_update = 0`; LIGGGHTS `tangential_model_history.h`:
+//!   `if (update->setupflag) history_update = 0`, and `pair_gran_hooke_history.cpp`:
+//!   `if (update->setupflag) shearupdate = 0`; LIGGGHTS `tangential_model_history.h`:
 //!   `if (sidata.shearupdate && sidata.computeflag)`, with `shearupdate` false during set-up),
 //!   which is verdem's row 0: the row's own velocities, no increment.
 //! - row k ≥ 1: `run 1 pre no post no`: one step of `Verlet::run`, whose force evaluation
@@ -244,8 +245,10 @@ pub fn drive(
     motion: &[MotionRow],
     increment: Increment,
 ) -> anyhow::Result<Vec<ForceRow>> {
-    ensure!(!motion.is_empty(), "a motion of no rows");
     let (_, radius) = pair_of(case)?;
+    if motion.is_empty() {
+        return Ok(Vec::new());
+    }
     let placed = peer_case(case, motion, radius)?;
     let scene = crate::scene::build(&placed, None)?;
     let state = Snapshot {
