@@ -391,7 +391,7 @@ fn the_command_line_drives_the_peers_with_either_increment() {
             let printed = String::from_utf8_lossy(&printed.stdout);
             assert!(
                 printed.contains(&format!(
-                    "{} rows of objectivity ({}'s library, {} convention)",
+                    "{} rows of objectivity ({} through its library, {} convention)",
                     rows.len(),
                     peer.name(),
                     peer.convention().name()

@@ -81,7 +81,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             }
         ),
         Some(peer) => format!(
-            "{}'s library, {} convention",
+            "{} through its library, {} convention",
             peer.name(),
             peer.convention().name()
         ),

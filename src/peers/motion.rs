@@ -278,15 +278,24 @@ pub fn drive(
             .any(|w| w.parse::<f64>().is_ok_and(|x| !x.is_finite()))
     }) {
         anyhow::bail!(
-            "{}: the case's law has no finite {} input: `{line}` (LAMMPS' tangential damping is \
-             relative to the normal one: gammat needs gamman > 0)",
+            "{}: the case's law has no finite {} input: `{line}`{}",
             case.path.display(),
-            peer.name()
+            peer.name(),
+            if peer == MotionPeer::Lammps {
+                " (LAMMPS' pair granular gives the tangential damping relative to the normal \
+                 one: gammat needs gamman > 0)"
+            } else {
+                ""
+            }
         );
     }
     let mut lmp = Instance::open(api)?;
     lmp.script(&script)?;
-    // a full rebuild of the neighbour list every step, whatever the atoms moved
+    // read: the data file is no longer needed
+    drop(dir);
+    // a full rebuild of the neighbour list every step, whatever the atoms moved, by looking at
+    // all pairs (no bins over a box that may be large: it holds the whole motion)
+    lmp.command(&format!("neighbor        {:?} nsq", case.neighbor.skin))?;
     lmp.command("neigh_modify    delay 0 every 1 check no")?;
     lmp.command(&format!("timestep        {first_dt:?}"))?;
     let mut dt_now = first_dt;
