@@ -19,8 +19,9 @@
 //!   which is verdem's row 0: the row's own velocities, no increment.
 //! - row k ≥ 1: `run 1 pre no post no`: one step of `Verlet::run`, whose force evaluation
 //!   advances the history by the velocities set times dt (so `run 0` would not do: it never
-//!   advances it), with the neighbour list rebuilt every step (`neigh_modify every 1 delay 0
-//!   check no`; the history follows the pair across rebuilds). The velocities are the step
+//!   advances it), with the neighbour list rebuilt from all pairs every step (`neighbor SKIN
+//!   nsq`, `neigh_modify every 1 delay 0 check no`; the history follows the pair across
+//!   rebuilds). The velocities are the step
 //!   averages of [`Increment`], as verdem's. The code's dt is the rows' spacing t_k − t_(k−1):
 //!   where the spacing changes (beyond the rounding of the times, [`SAME_STEP`]) a `timestep`
 //!   command and a run with its set-up (`run 1 post no`), since LAMMPS' pair keeps its own
