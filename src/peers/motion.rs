@@ -3,9 +3,10 @@
 //! laws, in process, through their C library interfaces ([`library`], loaded at run time).
 //!
 //! The input is the one the peers' cross-runs and binary collisions use
-//! ([`lammps_family::Dialect::setup_and_law`]: LAMMPS `pair_style granular` hooke /
+//! ([`super::lammps_family::Dialect::setup_and_law`]: LAMMPS `pair_style granular` hooke /
 //! `linear_history` / `damping velocity`, LIGGGHTS `gran model hooke/stiffness tangential
-//! history absolute_damping on`), read from a data file of the case's two spheres in a
+//! history absolute_damping on`), or LAMMPS' classic `gran/hooke/history` (`hooke_history`),
+//! read from a data file of the case's two spheres in a
 //! non-periodic box that holds every row of the motion, with no time integration fix: nothing
 //! moves the atoms but this driver. Per row it sets both spheres' positions, velocities and
 //! spins (orientations: a sphere's force does not depend on them), then lets the code evaluate
@@ -21,9 +22,9 @@
 //!   advances the history by the velocities set times dt (so `run 0` would not do: it never
 //!   advances it), with the neighbour list rebuilt from all pairs every step (`neighbor SKIN
 //!   nsq`, `neigh_modify every 1 delay 0 check no`; the history follows the pair across
-//!   rebuilds). The velocities are the step
-//!   averages of [`Increment`], as verdem's. The code's dt is the rows' spacing t_k − t_(k−1):
-//!   where the spacing changes (beyond the rounding of the times, [`SAME_STEP`]) a `timestep`
+//!   rebuilds). The velocities are the step averages of [`Increment`], as verdem's. The
+//!   code's dt is the rows' spacing t_k − t_(k−1):
+//!   where the spacing changes (beyond the rounding of the times, `SAME_STEP`) a `timestep`
 //!   command and a run with its set-up (`run 1 post no`), since LAMMPS' pair keeps its own
 //!   copy of dt.
 //!
