@@ -1,11 +1,13 @@
 //! `verdem kinematics`: drive one contact of the case's law through a prescribed motion and
-//! write the forces and torques at every row.
+//! write the forces and torques at every row; with `--peer`, the contact law of the real LAMMPS
+//! or LIGGGHTS, through its library.
 
 use std::path::PathBuf;
 
 use verdem::case::Case;
 use verdem::io::{self, atomic};
 use verdem::kinematics::{self, Increment};
+use verdem::peers::motion::{self, MotionPeer};
 
 use super::args::described;
 use super::Finished;
@@ -27,6 +29,14 @@ pub struct Args {
         value_parser = described(&Increment::ALL, Increment::name, Increment::description)
     )]
     increment: Increment,
+    /// Drive the contact law of a peer's library instead of verdem's (the case gives radii,
+    /// density and kn, gamman, kt, gammat, mu; the peer's own convention replaces
+    /// `tangential`, and its normal force is not clipped).
+    #[arg(
+        long,
+        value_parser = described(&MotionPeer::ALL, MotionPeer::name, MotionPeer::description)
+    )]
+    peer: Option<MotionPeer>,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -36,8 +46,13 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         .into_iter()
         .unzip();
     let (_, radius) = kinematics::pair_of(&case)?;
-    let law = kinematics::law_of(&case);
-    let forces = kinematics::drive(law.as_ref(), radius, &rows, a.increment);
+    let forces = match a.peer {
+        None => {
+            let law = kinematics::law_of(&case);
+            kinematics::drive(law.as_ref(), radius, &rows, a.increment)
+        }
+        Some(peer) => motion::drive(peer, &case, &rows, a.increment)?,
+    };
     let finite = |r: &kinematics::ForceRow| {
         let vectors = r.f.iter().chain(&r.torque).flat_map(|v| v.iter().copied());
         [r.t, r.delta, r.fn_signed, r.ft]
@@ -55,16 +70,26 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         );
     }
     atomic::write(&a.out, kinematics::forces_csv(&forces).as_bytes())?;
+    let law = match a.peer {
+        None => format!(
+            "{} convention{}",
+            case.contact.tangential.name(),
+            if case.contact.clip_normal {
+                ", clipped normal force"
+            } else {
+                ""
+            }
+        ),
+        Some(peer) => format!(
+            "{} through its library, {} convention",
+            peer.name(),
+            peer.convention().name()
+        ),
+    };
     println!(
-        "{} rows of {} ({} convention{}) -> {}",
+        "{} rows of {} ({law}) -> {}",
         forces.len(),
         case.name,
-        case.contact.tangential.name(),
-        if case.contact.clip_normal {
-            ", clipped normal force"
-        } else {
-            ""
-        },
         a.out.display()
     );
     Ok(Finished::Done)

@@ -35,7 +35,8 @@ pair_coeff      * * hooke {kn:?} {gn:?} tangential linear_history {kt:?} {xgt:?}
             gn = c.gamman,
             kt = c.kt,
             gt = c.gammat,
-            xgt = c.gammat / c.gamman,
+            // no tangential damping is x = 0 whatever the normal one (also when that is 0)
+            xgt = if c.gammat == 0.0 { 0.0 } else { c.gammat / c.gamman },
             mu = c.mu,
         )
     }

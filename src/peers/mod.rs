@@ -18,6 +18,7 @@ pub mod kratos;
 pub mod lammps;
 pub mod lammps_family;
 pub mod liggghts;
+pub mod motion;
 pub mod yade;
 
 use crate::case::{Case, Scene, Tangential};
