@@ -394,7 +394,10 @@ fn a_law_that_gives_back_more_than_it_received_is_stopped() {
         "{failure}"
     );
     let excess = run(15.0, 0.01).expect("the dissipative law runs");
-    assert_eq!(excess, 0.0, "a dissipative collision never gives out more than it took");
+    assert_eq!(
+        excess, 0.0,
+        "a dissipative collision never gives out more than it took"
+    );
 }
 
 /// A periodic gas of 500 spheres whose law gives back about 2 % more energy than each collision
@@ -410,8 +413,8 @@ fn a_slightly_creative_law_is_found_in_a_large_gas() {
     use verdem::neighbor::NeighborBuilder;
     use verdem::step::{Core, Engine, Simulation};
 
-    let case = verdem::case::Case::load(&common::root().join("cases/verify/conservation.toml"))
-        .unwrap();
+    let case =
+        verdem::case::Case::load(&common::root().join("cases/verify/conservation.toml")).unwrap();
     let steps = 6000;
     let run = |contact: f64| {
         let scene = verdem::scene::build(&case, None).unwrap();

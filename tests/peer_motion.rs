@@ -300,7 +300,8 @@ fn objectivity(peer: MotionPeer) {
         );
         assert!(d <= bound(rows.len()), "{name}: difference {d:e}");
         let measured = drifts(&case, &real, loaded, axis);
-        let reimplemented = verdem::verify::objectivity::drifts(&case, axis).unwrap();
+        let reimplemented =
+            verdem::verify::objectivity::drifts(&case, axis, &verdem::verify::driver::OWN).unwrap();
         // the drifts are differences of forces relative to the loaded state's; the direction
         // error is an arc cosine, resolved to about √(2ε) ≈ 2e-8 near zero
         let tolerances = [bound(rows.len()), bound(rows.len()), 1e-7];

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use verdem::case::{Case, Tangential};
+use verdem::peers::motion::MotionPeer;
 use verdem::peers::{self, Peer};
 use verdem::verify::driver::External;
 use verdem::verify::{self, Subject};
@@ -77,9 +78,24 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         None => verify::run(&verify::select(verify::entries(&a.cases), only)?)?,
     };
     let collision = Case::load(&a.cases.join("binary_collision.toml"))?;
-    for peer in a.peers {
+    for &peer in &a.peers {
         let dir = a.out.join(peer.binary());
         rows.extend(peers::collision::rows(peer, &collision, &dir)?);
+    }
+    // The prescribed-motion cases in the peers' libraries, held to verdem's re-implementation of
+    // each convention where it has a known defect. After every binary has run: an MPI library
+    // started in this process leaves an environment that MPI programs started from it inherit
+    // and fail on.
+    let libraries = MotionPeer::ALL
+        .into_iter()
+        .filter(|m| a.peers.iter().any(|p| m.belongs_to(p.name())));
+    for library in libraries {
+        let subject = Subject::code(&library, Some(library.convention()));
+        let entries: Vec<_> = verify::code_entries(&a.cases, &subject)
+            .into_iter()
+            .filter(|e| only.is_none_or(|o| e.selected(o)))
+            .collect();
+        rows.extend(verify::run(&entries)?);
     }
     if let Some(only) = only {
         rows.retain(|r| r.case.contains(only));

@@ -48,6 +48,7 @@ use super::liggghts::Liggghts;
 use crate::case::{Case, Scene, Tangential};
 use crate::kinematics::{pair_of, ForceRow, Increment, MotionRow};
 use crate::state::Snapshot;
+use crate::verify::driver::MotionDriver;
 use crate::Vec3;
 
 /// A peer whose contact law can be driven through a prescribed motion in process.
@@ -102,6 +103,15 @@ impl MotionPeer {
             MotionPeer::Lammps => Lammps::CONVENTION,
             MotionPeer::LammpsHookeHistory => Tangential::LammpsHookeHistory,
             MotionPeer::Liggghts => Liggghts::CONVENTION,
+        }
+    }
+
+    /// Whether it is the library of the cross-run peer named `peer` (`lammps` has two pair
+    /// styles).
+    pub fn belongs_to(self, peer: &str) -> bool {
+        match self.flavour() {
+            Flavour::Lammps => peer == Lammps::NAME,
+            Flavour::Liggghts => peer == Liggghts::NAME,
         }
     }
 
@@ -235,6 +245,18 @@ impl TempDir {
 impl Drop for TempDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A peer's library drives the verification's prescribed-motion cases (`verdem verify --peers`)
+/// with the increments verdem's integrator feeds its own law.
+impl MotionDriver for MotionPeer {
+    fn drive(&self, case: &Case, motion: &[MotionRow]) -> anyhow::Result<Vec<ForceRow>> {
+        drive(*self, case, motion, Increment::Positions)
+    }
+
+    fn name(&self) -> String {
+        format!("{} library", MotionPeer::name(*self))
     }
 }
 

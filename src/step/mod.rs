@@ -243,7 +243,11 @@ impl<L: ContactLaw> Simulation<L> {
             };
             for k in 0..arr.p.len() {
                 let (p, i) = (arr.p.get(k) as usize, arr.i.get(k) as usize);
-                let slot = (arr.history.at_mut(k), arr.active.at_mut(k), arr.out.at_mut(k));
+                let slot = (
+                    arr.history.at_mut(k),
+                    arr.active.at_mut(k),
+                    arr.out.at_mut(k),
+                );
                 pair_force::<L, true>(&view, p, i, slot);
             }
             if arr.active.slice(0..arr.active.len()).contains(&true) {
