@@ -76,8 +76,15 @@ fn verdem_kinematics_as_a_program_passes_every_row_with_verdems_own_numbers() {
     let cmd = format!("{} kinematics", env!("CARGO_BIN_EXE_verdem"));
     let program = External::new(&cmd, "verdem", scratch.path());
     let rows = code_rows(&program, None);
-    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4);
-    assert!(rows.iter().all(|r| r.passed() && r.gate), "{rows:#?}");
+    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4 + 2 * 2);
+    assert!(failed(&rows).is_empty(), "{rows:#?}");
+    // every row gates but McNamara's net work, which the objective law's torques (arms
+    // R − δ/2, slip R) do not close (docs/verification.md)
+    let shown: Vec<_> = rows.iter().filter(|r| !r.gate).collect();
+    assert!(
+        shown.len() == 2 && shown.iter().all(|r| r.quantity.starts_with("net work")),
+        "{shown:#?}"
+    );
     // bit for bit the numbers of verdem's law driven through the motion the file holds
     let read_back = code_rows(&ReadBack, None);
     for (r, b) in rows.iter().zip(&read_back) {
@@ -197,11 +204,20 @@ fn a_spring_not_turned_into_the_new_tangent_plane_fails_the_rotations_out_of_the
 #[test]
 fn a_tangential_stiffness_10_percent_off_fails_the_spring_force_and_energy_rows() {
     let rows = python_rows(Some("kt"));
-    // the spring force for a given slip, the spring after the Coulomb reset, and the work of
-    // the cycle measured in the elastic energy of the case's kt
+    // the spring force for a given slip, the spring after the Coulomb reset, the work of the
+    // cycle measured in the elastic energy of the case's kt, and McNamara's residual spring
+    // measured in kt·θ·|δ2 − δ1|
     assert_eq!(
         failed(&rows),
         set(&[
+            (
+                "mcnamara code:law spin fn x2",
+                "residual |Ft| / (kt theta |d delta|) = verdem mercury"
+            ),
+            (
+                "mcnamara code:law spin fn x2",
+                "residual / (c kt theta |d delta|)"
+            ),
             (
                 "tangential code:law load-unload",
                 "F2.(t x n) / (kt l2 phi)"
@@ -225,6 +241,10 @@ fn torques_of_the_wrong_sign_fail_the_torque_and_work_rows() {
     assert_eq!(
         failed(&rows),
         set(&[
+            (
+                "mcnamara code:law spin fn x2",
+                "net work / (kn delta2^2 / 2) = verdem mercury"
+            ),
             ("tangential code:law load-unload", "T1.t / (l1 |Ft|)"),
             ("tangential code:law load-unload", "T2.t / (l2 |Ft|)"),
             (

@@ -2,7 +2,8 @@
 //! García-Rojo & Herrmann, "Microscopic origin of granular ratcheting", PRE 77, 031304, 2008,
 //! arXiv:0708.1389: the energy stored in a contact is path dependent for the usual tangential
 //! laws, "there exist closed paths that change the stored energy, even if the particles remain
-//! in contact and do not slide"), per tangential convention, through the kinematics driver.
+//! in contact and do not slide"), per tangential convention, through a [`MotionDriver`]: verdem's
+//! law, an external program (`verdem verify --code`) or a peer's library.
 //!
 //! The cycle, as Yade's `Ig2_Sphere_Sphere_ScGeom::avoidGranularRatcheting` documents it: at
 //! the overlap δ1 (normal load fn1 = kn δ1) (1) rotate by θ, (2) press along the normal to δ2,
@@ -22,10 +23,11 @@
 
 use nalgebra::UnitQuaternion;
 
+use super::driver::{MotionDriver, OWN};
 use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
-use super::{row_abs, Row};
+use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{drive, law_of, pair_of, ForceRow, Increment, MotionRow};
+use crate::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Steps of each leg of the cycle.
@@ -151,15 +153,25 @@ pub fn motion(case: &Case, rotation: Rotation, loads: Loads) -> anyhow::Result<V
 }
 
 /// One cycle of `case`'s law (dashpots switched off) with the rotation `rotation` and the
-/// overlaps and angle `loads`.
-pub fn cycle(case: &Case, rotation: Rotation, loads: Loads) -> anyhow::Result<Cycle> {
+/// overlaps and angle `loads`, driven by `driver`.
+pub fn cycle(
+    case: &Case,
+    rotation: Rotation,
+    loads: Loads,
+    driver: &dyn MotionDriver,
+) -> anyhow::Result<Cycle> {
     let mut elastic = case.clone();
     elastic.contact.gamman = 0.0;
     elastic.contact.gammat = 0.0;
     let rows = motion(&elastic, rotation, loads)?;
-    let (_, radius) = pair_of(&elastic)?;
-    let law = law_of(&elastic);
-    let f = drive(law.as_ref(), radius, &rows, Increment::Positions);
+    let f = driver.drive(&elastic, &rows)?;
+    anyhow::ensure!(
+        f.len() == rows.len(),
+        "{}: {} rows of forces for {} rows of motion",
+        driver.name(),
+        f.len(),
+        rows.len()
+    );
     Ok(Cycle {
         residual: f.last().map_or(0.0, |r| r.ft),
         peak: f.iter().map(|r| r.ft).fold(0.0, f64::max),
@@ -201,67 +213,73 @@ pub fn torques_conjugate_to_slip(conv: Tangential) -> bool {
     }
 }
 
-/// The McNamara-cycle rows of every tangential convention, for each rotation: the residual
-/// tangential force in units of kt·θ·|δ2 − δ1| (the theory's residual with c = 1) and the net
-/// work per cycle in units of the largest normal elastic energy ½·kn·δ2², both expected 0;
-/// and, where the theory predicts a residual, the residual against c·kt·θ·|δ2 − δ1|. The
-/// residual is judged for the objective law and documents the others (FAIL* where they
-/// ratchet); the net work is judged only for a law whose torques are conjugate to its slip and
-/// which claims objectivity (none yet: the objective law's torques use R − δ/2).
-pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
+/// The cycles' names, one per [`Rotation`]: the variants of the verification table's case.
+pub const CYCLES: [&str; 2] = [Rotation::Spin.name(), Rotation::Rigid.name()];
+
+/// The name of the cycle `variant` (one of [`CYCLES`]) of `subject`'s contact.
+pub fn case_name(subject: &str, variant: &str) -> String {
+    format!("mcnamara {subject} {variant} fn x2")
+}
+
+/// The McNamara-cycle rows of `subject` for the cycle `variant` (one of [`CYCLES`]): the
+/// residual tangential force in units of kt·θ·|δ2 − δ1| (the theory's residual with c = 1) and
+/// the net work per cycle in units of the largest normal elastic energy ½·kn·δ2², both
+/// expected 0; and, where the theory predicts a residual for the subject's convention, the
+/// residual against c·kt·θ·|δ2 − δ1|. The residual gates for a subject that claims
+/// objectivity and documents the others (FAIL* where they ratchet); the net work gates only
+/// for a law whose torques are conjugate to its slip and which claims objectivity (none yet:
+/// the objective law's torques use R − δ/2).
+pub fn cycle_rows(base: &Case, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
+    let rotation = Rotation::ALL
+        .into_iter()
+        .find(|r| r.name() == variant)
+        .ok_or_else(|| anyhow::anyhow!("no McNamara cycle is called {variant:?}"))?;
     let (_, radius) = pair_of(base)?;
     let reach = radius[0] + radius[1];
-    let mut rows = Vec::new();
-    for conv in Tangential::ALL {
-        let mut case = base.clone();
-        case.contact.tangential = conv;
-        for rotation in Rotation::ALL {
-            let l = loads(&case, rotation)?;
-            let c = cycle(&case, rotation, l)?;
-            let name = format!("mcnamara {} {} fn x2", conv.name(), rotation.name());
-            let (kn, kt) = (case.contact.kn, case.contact.kt);
-            let dd = (l.delta2 - l.delta1).abs();
-            let force = kt * l.theta * dd;
-            let energy = 0.5 * kn * l.delta2 * l.delta2;
-            // round-off: positions of size R1 + R2 carry ε·(R1 + R2) each, the spring as
-            // much; 100 times that against the scale kt·θ·|δ2 − δ1|
-            let force_round_off = 100.0 * f64::EPSILON * reach / (l.theta * dd);
-            // the work sums 4·STEPS_PER_LEG terms fn·dx, each with ε·fn2·(R1 + R2)
-            let steps = 4.0 * STEPS_PER_LEG as f64;
-            let work_round_off = steps * f64::EPSILON * kn * l.delta2 * reach / energy;
-            let objective = conv.properties().objective;
-            rows.push(
-                row_abs(
-                    &name,
-                    "residual |Ft| / (kt theta |d delta|)",
-                    0.0,
-                    c.residual / force,
-                    force_round_off,
-                )
-                .gating_if(objective),
-            );
-            rows.push(
-                row_abs(
-                    &name,
-                    "net work / (kn delta2^2 / 2)",
-                    0.0,
-                    c.work / energy,
-                    work_round_off,
-                )
-                .gating_if(objective && torques_conjugate_to_slip(conv)),
-            );
-            let factor = theory_factor(conv, rotation);
-            if factor > 0.0 {
-                // higher orders: O(θ²) = 1e-2 of the rigid rotation's chord and frame
-                rows.push(super::row(
-                    &name,
-                    "residual / (c kt theta |d delta|)",
-                    1.0,
-                    c.residual / (factor * force),
-                    1e-2,
-                ));
-            }
-        }
+    let case = subject.case(base);
+    let conv = subject.tangential;
+    let l = loads(&case, rotation)?;
+    let c = cycle(&case, rotation, l, subject.driver)?;
+    let name = case_name(&subject.label, variant);
+    let (kn, kt) = (case.contact.kn, case.contact.kt);
+    let dd = (l.delta2 - l.delta1).abs();
+    let force = kt * l.theta * dd;
+    let energy = 0.5 * kn * l.delta2 * l.delta2;
+    // round-off: positions of size R1 + R2 carry ε·(R1 + R2) each, the spring as much; 100
+    // times that against the scale kt·θ·|δ2 − δ1|
+    let force_round_off = 100.0 * f64::EPSILON * reach / (l.theta * dd);
+    // the work sums 4·STEPS_PER_LEG terms fn·dx, each with ε·fn2·(R1 + R2)
+    let steps = 4.0 * STEPS_PER_LEG as f64;
+    let work_round_off = steps * f64::EPSILON * kn * l.delta2 * reach / energy;
+    let objective = subject.properties.objective;
+    let mut rows = vec![
+        row_abs(
+            &name,
+            "residual |Ft| / (kt theta |d delta|)",
+            0.0,
+            c.residual / force,
+            force_round_off,
+        )
+        .gating_if(objective),
+        row_abs(
+            &name,
+            "net work / (kn delta2^2 / 2)",
+            0.0,
+            c.work / energy,
+            work_round_off,
+        )
+        .gating_if(objective && torques_conjugate_to_slip(conv)),
+    ];
+    let factor = theory_factor(conv, rotation);
+    if factor > 0.0 {
+        // higher orders: O(θ²) = 1e-2 of the rigid rotation's chord and frame
+        rows.push(super::row(
+            &name,
+            "residual / (c kt theta |d delta|)",
+            1.0,
+            c.residual / (factor * force),
+            1e-2,
+        ));
     }
     Ok(rows)
 }
@@ -295,7 +313,7 @@ pub fn exponent(points: &[(f64, f64)]) -> Exponent {
 pub fn scaling(case: &Case, rotation: Rotation) -> anyhow::Result<[Exponent; 3]> {
     let base = loads(case, rotation)?;
     let scales = [1.0, 2.0, 4.0, 8.0];
-    let residual = |case: &Case, l: Loads| cycle(case, rotation, l).map(|c| c.residual);
+    let residual = |case: &Case, l: Loads| cycle(case, rotation, l, &OWN).map(|c| c.residual);
     let mut load = Vec::new();
     let mut stiffness = Vec::new();
     let mut amplitude = Vec::new();
