@@ -15,7 +15,7 @@ use verdem::case::Case;
 use verdem::kinematics::{self, ForceRow, Increment, MotionRow};
 use verdem::peers::motion::{self, MotionPeer};
 use verdem::verify::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis, tangential_force};
-use verdem::verify::{self, row_abs, Row};
+use verdem::verify::{self, ratchet, row_abs, Row};
 use verdem::Vec3;
 
 /// The tolerance of the verification table's objectivity and ratchet rows.
@@ -148,68 +148,12 @@ fn axes(case: &Case) -> [(&'static str, Vec3); 3] {
     ]
 }
 
-/// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`
-/// (the orbit of `src/verify/ratchet.rs`).
-fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f64) {
-    let from = *rows.last().unwrap();
-    let axis = Unit::new_normalize(axis);
-    let omega = axis.into_inner() * (angle / (steps as f64 * dt));
-    for k in 1..=steps {
-        let q = UnitQuaternion::from_axis_angle(&axis, angle * k as f64 / steps as f64);
-        let mut row = from;
-        row.t = from.t + k as f64 * dt;
-        row.x[1] = from.x[0] + q * (from.x[1] - from.x[0]);
-        row.v[1] = omega.cross(&(row.x[1] - from.x[0]));
-        rows.push(row);
-    }
-}
-
-/// The ratcheting cycle of `src/verify/ratchet.rs` (`cycle`) at overlap `overlap`: orbit by
-/// the arc `dx`, rotate the pair by 0.1 rad about `axis`, orbit back, rotate back.
-fn ratchet_motion(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> Vec<MotionRow> {
-    let (mut x, radius) = kinematics::pair_of(case).unwrap();
-    let dt = case.dt();
-    let n0 = (x[1] - x[0]).normalize();
-    x[1] = x[0] + n0 * (radius[0] + radius[1] - overlap);
-    let orbit_axis = tangent_axis(n0);
-    let theta = dx / (radius[0] + radius[1]);
-    let a = 0.1;
-    let mut rows = vec![MotionRow {
-        t: 0.0,
-        x,
-        q: [UnitQuaternion::identity(); 2],
-        v: [Vec3::zeros(); 2],
-        w: [Vec3::zeros(); 2],
-    }];
-    orbit(&mut rows, orbit_axis, theta, 2000, dt);
-    rigid_rotation(&mut rows, axis, a, 10_000, dt);
-    let turned = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), a) * orbit_axis;
-    orbit(&mut rows, turned, -theta, 2000, dt);
-    rigid_rotation(&mut rows, axis, -a, 10_000, dt);
-    rows
-}
-
-/// Net work done on the contact over the rows (trapezoidal in the forces), as
-/// `src/verify/ratchet.rs` measures it.
-fn net_work(rows: &[MotionRow], f: &[ForceRow]) -> f64 {
-    let mut w = 0.0;
-    for k in 1..rows.len() {
-        for s in 0..2 {
-            let dx = rows[k].x[s] - rows[k - 1].x[s];
-            let dphi = (rows[k].q[s] * rows[k - 1].q[s].inverse()).scaled_axis();
-            w += 0.5 * (f[k].f[s] + f[k - 1].f[s]).dot(&dx);
-            w += 0.5 * (f[k].torque[s] + f[k - 1].torque[s]).dot(&dphi);
-        }
-    }
-    w
-}
-
 /// Residual |Ft| over the peak |Ft|, and net work over the peak elastic energy, of a cycle.
 fn ratchet_measures(case: &Case, rows: &[MotionRow], f: &[ForceRow]) -> [f64; 2] {
     let peak = f.iter().map(|r| r.ft).fold(0.0, f64::max);
     let residual = f.last().unwrap().ft;
     let energy = peak * peak / (2.0 * case.contact.kt);
-    [residual / peak, net_work(rows, f) / energy]
+    [residual / peak, ratchet::net_work(rows, f) / energy]
 }
 
 fn ratchet(peer: MotionPeer) {
@@ -228,7 +172,7 @@ fn ratchet(peer: MotionPeer) {
     for (label, axis) in [("rotation about n", n0), ("rotation about t", along)] {
         let mut residuals = Vec::new();
         for load in [1.0, 2.0] {
-            let rows = ratchet_motion(&case, axis, load * overlap, dx);
+            let rows = ratchet::motion(&case, axis, load * overlap, dx).unwrap();
             let real = motion::drive(peer, &case, &rows, Increment::Positions).unwrap();
             let ours = verdem(&case, &rows);
             let d = difference(&real, &ours);

@@ -25,9 +25,10 @@ use nalgebra::UnitQuaternion;
 
 use super::driver::{MotionDriver, OWN};
 use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
+use super::ratchet::net_work;
 use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{pair_of, ForceRow, MotionRow};
+use crate::kinematics::{pair_of, MotionRow};
 use crate::Vec3;
 
 /// Steps of each leg of the cycle.
@@ -108,21 +109,6 @@ fn press(rows: &mut Vec<MotionRow>, push: f64, steps: usize, dt: f64) {
         row.v[1] = v;
         rows.push(row);
     }
-}
-
-/// Net work done by the forces and torques `f` on the spheres over `rows` (trapezoidal in the
-/// forces, exact displacements and rotation vectors; force·length).
-fn net_work(rows: &[MotionRow], f: &[ForceRow]) -> f64 {
-    let mut w = 0.0;
-    for k in 1..rows.len() {
-        for s in 0..2 {
-            let dx = rows[k].x[s] - rows[k - 1].x[s];
-            let dphi = (rows[k].q[s] * rows[k - 1].q[s].inverse()).scaled_axis();
-            w += 0.5 * (f[k].f[s] + f[k - 1].f[s]).dot(&dx);
-            w += 0.5 * (f[k].torque[s] + f[k - 1].torque[s]).dot(&dphi);
-        }
-    }
-    w
 }
 
 /// The motion of one cycle of `case`'s pair (sphere 2 moved along the normal to the overlap

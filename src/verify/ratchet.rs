@@ -42,7 +42,7 @@ fn orbit(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: usize, dt: f6
 
 /// Net work done on the contact over the rows (trapezoidal in the forces, exact displacements
 /// and rotation vectors), in units of force·length.
-fn net_work(rows: &[MotionRow], f: &[ForceRow]) -> f64 {
+pub fn net_work(rows: &[MotionRow], f: &[ForceRow]) -> f64 {
     let mut w = 0.0;
     for k in 1..rows.len() {
         for s in 0..2 {
@@ -66,16 +66,10 @@ pub struct Cycle {
     pub work: f64,
 }
 
-/// One cycle of `case`'s contact, driven by `driver`, with the pair rotated about `axis` by
-/// 0.1 rad, at the case's positions scaled to the overlap `overlap`, translating by the arc
-/// `dx`.
-pub fn cycle(
-    case: &Case,
-    axis: Vec3,
-    overlap: f64,
-    dx: f64,
-    driver: &dyn MotionDriver,
-) -> anyhow::Result<Cycle> {
+/// The motion of one cycle of `case`'s pair: at the case's positions scaled to the overlap
+/// `overlap`, sphere 2 orbits sphere 1 by the arc `dx`, the pair rotates by 0.1 rad about
+/// `axis`, sphere 2 orbits back, the pair rotates back.
+pub fn motion(case: &Case, axis: Vec3, overlap: f64, dx: f64) -> anyhow::Result<Vec<MotionRow>> {
     let (mut x, radius) = pair_of(case)?;
     let dt = case.dt();
     let n0 = (x[1] - x[0]).normalize();
@@ -95,6 +89,18 @@ pub fn cycle(
     let turned = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), a) * orbit_axis;
     orbit(&mut rows, turned, -theta, 2000, dt);
     rigid_rotation(&mut rows, axis, -a, 10_000, dt);
+    Ok(rows)
+}
+
+/// One cycle of `case`'s contact ([`motion`]), driven by `driver`.
+pub fn cycle(
+    case: &Case,
+    axis: Vec3,
+    overlap: f64,
+    dx: f64,
+    driver: &dyn MotionDriver,
+) -> anyhow::Result<Cycle> {
+    let rows = motion(case, axis, overlap, dx)?;
     let f = driver.drive(case, &rows)?;
     Ok(Cycle {
         residual: f.last().map_or(0.0, |r| r.ft),
