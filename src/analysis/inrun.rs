@@ -159,15 +159,11 @@ impl Inrun {
                 continue;
             }
             // The contact point exactly as the force pass and the .fstat rows have it.
-            let Some(g) = (PairInput {
-                r: self.domain.min_image(p.x[a] - p.x[o]),
-                rad_p: p.radius[a],
-                rad_i: p.radius[o],
-                v_p: Vec3::zeros(),
-                v_i: Vec3::zeros(),
-                w_p: Vec3::zeros(),
-                w_i: Vec3::zeros(),
-            })
+            let Some(g) = (PairInput::at_rest(
+                self.domain.min_image(p.x[a] - p.x[o]),
+                p.radius[a],
+                p.radius[o],
+            ))
             .kinematics() else {
                 continue;
             };

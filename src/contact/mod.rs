@@ -72,6 +72,21 @@ pub struct PairInput {
 }
 
 impl PairInput {
+    /// Two spheres of radii `rad_p` and `rad_i` (length) at separation `r` = x_P − x_I
+    /// (minimum image), at rest: what the saves' writers need to find a contact's normal,
+    /// overlap and contact point exactly as the force pass computed them.
+    pub fn at_rest(r: Vec3, rad_p: f64, rad_i: f64) -> PairInput {
+        PairInput {
+            r,
+            rad_p,
+            rad_i,
+            v_p: Vec3::zeros(),
+            v_i: Vec3::zeros(),
+            w_p: Vec3::zeros(),
+            w_i: Vec3::zeros(),
+        }
+    }
+
     /// Contact geometry and kinematics, or `None` when the spheres do not touch
     /// (contact iff |x_P − x_I| < r_P + r_I, strict, as in MercuryDPM).
     #[inline(always)]
@@ -202,15 +217,7 @@ mod tests {
     use super::*;
 
     fn input(r: Vec3) -> PairInput {
-        PairInput {
-            r,
-            rad_p: 0.5,
-            rad_i: 0.5,
-            v_p: Vec3::zeros(),
-            v_i: Vec3::zeros(),
-            w_p: Vec3::zeros(),
-            w_i: Vec3::zeros(),
-        }
+        PairInput::at_rest(r, 0.5, 0.5)
     }
 
     #[test]

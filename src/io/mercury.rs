@@ -102,15 +102,11 @@ pub fn fstat_text(core: &Snapshot) -> String {
     for contact in &core.contacts {
         let (pp, ii) = (contact.p as usize, contact.i as usize);
         // n, δ and the contact point exactly as the force pass computed them.
-        let Some(g) = (PairInput {
-            r: core.domain.min_image(p.x[pp] - p.x[ii]),
-            rad_p: p.radius[pp],
-            rad_i: p.radius[ii],
-            v_p: Vec3::zeros(),
-            v_i: Vec3::zeros(),
-            w_p: Vec3::zeros(),
-            w_i: Vec3::zeros(),
-        })
+        let Some(g) = (PairInput::at_rest(
+            core.domain.min_image(p.x[pp] - p.x[ii]),
+            p.radius[pp],
+            p.radius[ii],
+        ))
         .kinematics() else {
             continue;
         };

@@ -71,15 +71,11 @@ impl Frame {
         let mut contacts = Vec::with_capacity(core.contacts.len());
         for c in &core.contacts {
             let (a, b) = (c.p as usize, c.i as usize);
-            let touching = PairInput {
-                r: core.domain.min_image(p.x[a] - p.x[b]),
-                rad_p: p.radius[a],
-                rad_i: p.radius[b],
-                v_p: Vec3::zeros(),
-                v_i: Vec3::zeros(),
-                w_p: Vec3::zeros(),
-                w_i: Vec3::zeros(),
-            }
+            let touching = PairInput::at_rest(
+                core.domain.min_image(p.x[a] - p.x[b]),
+                p.radius[a],
+                p.radius[b],
+            )
             .kinematics();
             let Some(g) = touching else { continue };
             let normal = c.force.fn_signed * g.n;
