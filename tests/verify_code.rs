@@ -337,3 +337,46 @@ fn a_broken_program_gets_an_error_row_naming_what_went_wrong() {
         "{stdout}"
     );
 }
+
+/// A program that never ends is stopped after `--code-timeout` seconds, with its children (the
+/// shell's `sleep`), and its case gets an ERROR row saying so; the other cases still run.
+#[test]
+fn a_program_that_hangs_is_stopped_after_its_timeout() {
+    let out = tempfile::tempdir().unwrap();
+    let started = std::time::Instant::now();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args([
+            "verify",
+            "--only",
+            "load-unload",
+            "--code",
+            "sleep 100; true",
+        ])
+        .args(["--code-timeout", "1", "--out"])
+        .arg(out.path())
+        .arg("--cases")
+        .arg(cases())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert_eq!(run.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("did not end within 1 s and was stopped"),
+        "{stdout}"
+    );
+    let row = stdout
+        .lines()
+        .find(|l| l.contains("load-unload"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(row.ends_with("ERROR"), "{row}");
+    // one run of at most a second and the kill, not the program's 100 s
+    assert!(started.elapsed().as_secs() < 60, "{:?}", started.elapsed());
+    let still = std::process::Command::new("pgrep")
+        .args(["-f", "sleep 100; true"])
+        .output()
+        .unwrap();
+    assert!(
+        still.stdout.is_empty(),
+        "the program's shell outlived the timeout"
+    );
+}

@@ -3,6 +3,7 @@
 //! through an external program instead.
 
 use std::path::PathBuf;
+use std::time::Duration;
 
 use verdem::case::{Case, Tangential};
 use verdem::peers::motion::MotionPeer;
@@ -35,6 +36,10 @@ pub struct Args {
     /// The program's name in the table (default: the file name of its script or program).
     #[arg(long, requires = "code")]
     code_name: Option<String>,
+    /// How long one run of the program may take, in seconds, before it is stopped and its
+    /// case reported as an ERROR row.
+    #[arg(long, requires = "code", default_value_t = 600.0, value_parser = super::args::positive)]
+    code_timeout: f64,
     /// The verdem convention the program implements: the case it gets names it, and its
     /// rows gate where verdem's law of that convention passes them (without it, every row
     /// gates: the promises of an objective law).
@@ -57,7 +62,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
                 .code_name
                 .clone()
                 .unwrap_or_else(|| External::default_name(cmd));
-            let program = External::new(cmd, &name, &a.out.join("code"));
+            let program = External::new(cmd, &name, &a.out.join("code"))
+                .with_timeout(Duration::from_secs_f64(a.code_timeout));
             let subject = Subject::code(&program, a.convention);
             let entries = verify::select(verify::code_entries(&a.cases, &subject), only)?;
             let rows = verify::run(&entries)?;

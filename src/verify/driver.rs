@@ -5,9 +5,11 @@
 //! verdem's law; [`External`] runs another program through files, with the interface of
 //! `verdem kinematics` (`docs/code-interface.md`).
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
@@ -65,18 +67,31 @@ pub struct External {
     pub name: String,
     /// Where each run's folder is made.
     pub scratch: PathBuf,
+    /// How long one run may take before it is stopped and reported.
+    pub timeout: Duration,
     runs: AtomicUsize,
 }
 
+/// How long one run of an external program may take by default: the longest prescribed
+/// motion has 1e5 rows, which a script in an interpreted language handles in seconds.
+pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(600);
+
 impl External {
-    /// The program `cmd`, named `name` in the table, running in folders under `scratch`.
+    /// The program `cmd`, named `name` in the table, running in folders under `scratch`, each
+    /// run stopped after [`DEFAULT_TIMEOUT`] (see [`External::with_timeout`]).
     pub fn new(cmd: &str, name: &str, scratch: &Path) -> External {
         External {
             cmd: cmd.into(),
             name: name.into(),
             scratch: scratch.into(),
+            timeout: DEFAULT_TIMEOUT,
             runs: AtomicUsize::new(0),
         }
+    }
+
+    /// The same with each run stopped after `timeout`.
+    pub fn with_timeout(self, timeout: Duration) -> External {
+        External { timeout, ..self }
     }
 
     /// A short name for the command: the file name of its first word that names an existing
@@ -134,7 +149,13 @@ impl External {
         forces_file: &Path,
         motion: &[MotionRow],
     ) -> anyhow::Result<Vec<ForceRow>> {
-        let out = Command::new("sh")
+        let dir = forces_file.parent().unwrap_or(Path::new("."));
+        let (stdout_file, stderr_file) = (dir.join("stdout.txt"), dir.join("stderr.txt"));
+        let create = |p: &Path| {
+            std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))
+        };
+        // its own process group, so that a run past its time is stopped with its children
+        let mut child = Command::new("sh")
             .arg("-c")
             .arg(format!("{} \"$@\"", self.cmd))
             .arg("sh")
@@ -143,12 +164,39 @@ impl External {
             .arg("--out")
             .arg(forces_file)
             .stdin(std::process::Stdio::null())
-            .output()
+            .stdout(create(&stdout_file)?)
+            .stderr(create(&stderr_file)?)
+            .process_group(0)
+            .spawn()
             .context("cannot start `sh -c` to run the program")?;
-        if !out.status.success() {
-            let stderr = String::from_utf8_lossy(&out.stderr);
+        let started = Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().context("cannot wait for the program")? {
+                break status;
+            }
+            if started.elapsed() > self.timeout {
+                // SIGKILL to the group: the shell and whatever it started
+                let _ = Command::new("kill")
+                    .args(["-KILL", "--", &format!("-{}", child.id())])
+                    .status();
+                let _ = child.wait();
+                anyhow::bail!(
+                    "`{} {} {} --out {}` did not end within {} s and was stopped (its output: {})",
+                    self.cmd,
+                    case_file.display(),
+                    motion_file.display(),
+                    forces_file.display(),
+                    self.timeout.as_secs_f64(),
+                    stderr_file.display()
+                );
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        if !status.success() {
+            let stderr = std::fs::read(&stderr_file).unwrap_or_default();
+            let stderr = String::from_utf8_lossy(&stderr);
             let tail: Vec<&str> = stderr.lines().rev().take(5).collect();
-            let status = match out.status.code() {
+            let status = match status.code() {
                 Some(127) => "exit code 127 (the command was not found)".to_string(),
                 Some(c) => format!("exit code {c}"),
                 None => "a signal".to_string(),
