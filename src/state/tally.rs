@@ -32,11 +32,11 @@ impl Tally {
     /// does: what that spring holds and has yet to give back only lowers the excess. `new` says
     /// the contact was not in contact at the step before: its account opens afresh, holding
     /// nothing; an account still closed otherwise opens here, holding what the contact's springs
-    /// hold now (`stored`, normal and tangential) plus this step's work.
+    /// hold now, normal and tangential (`held_now`, asked for only then), plus this step's work.
     #[inline(always)]
-    pub fn book(&mut self, w: f64, normal: f64, stored: f64, new: bool) -> f64 {
+    pub fn book(&mut self, w: f64, normal: f64, new: bool, held_now: impl FnOnce() -> f64) -> f64 {
         if new || !self.open {
-            let held = if new { 0.0 } else { w + stored };
+            let held = if new { 0.0 } else { w + held_now() };
             *self = Tally {
                 open: true,
                 given: 0.0,

@@ -343,13 +343,8 @@ unsafe fn guard_contact<L: ContactLaw>(
     // F_n·(v_(n−½) + v_(n+½))·dt/2: half of each of the two forces at these velocities.
     let work = 0.5 * view.dt * (touch.before.unwrap_or(0.0) + power(out, at));
     let normal = view.law.normal_energy(touch.delta);
-    let new = touch.before.is_none();
-    let stored = if tally.open || new {
-        normal
-    } else {
-        view.law.stored_energy(touch.delta, history)
-    };
-    let excess = tally.book(work, normal, stored, new);
+    let held_now = || view.law.stored_energy(touch.delta, history);
+    let excess = tally.book(work, normal, touch.before.is_none(), held_now);
     if excess > 0.0 {
         watch.pumped = watch.pumped.max(excess / tally.taken);
     }
