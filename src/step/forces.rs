@@ -175,14 +175,14 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
             forget(&mut s.history[k], &mut s.active[k]);
             continue;
         };
-        contact(view, touched, p, i, r, k, &mut s, &mut watch);
+        contact(view, touched, r, k, &mut s, &mut watch);
     }
     watch
 }
 
 /// Force of pair (p, i) into its slot (history, active flag, force); a pair that is not
-/// touching forgets its history. Returns the overlap (length) of a pair in contact. The run
-/// guard is not consulted (the forces before the first step).
+/// touching forgets its history. The run guard is not consulted (the forces before the first
+/// step).
 ///
 /// # Safety
 /// `p` and `i` index the views, and no thread writes their positions or velocities during the
@@ -193,12 +193,13 @@ pub(super) unsafe fn pair_force<L: ContactLaw, const PERIODIC: bool>(
     p: usize,
     i: usize,
     slot: (&mut L::History, &mut bool, &mut PairForce),
-) -> Option<f64> {
-    let Some(r) = touching::<L, PERIODIC>(view, p, i) else {
-        forget(slot.0, slot.1);
-        return None;
-    };
-    evaluate(view, p, i, r, slot).map(|touch| touch.delta)
+) {
+    match touching::<L, PERIODIC>(view, p, i) {
+        Some(r) => {
+            evaluate(view, p, i, r, slot);
+        }
+        None => forget(slot.0, slot.1),
+    }
 }
 
 /// The separation x_P − x_I of pair (p, i) (minimum image with `PERIODIC`), if the spheres
@@ -231,24 +232,22 @@ fn forget<H: Default>(history: &mut H, active: &mut bool) {
     }
 }
 
-/// The force of the contact in slot `k` of `s`, its run guard and its particles' `touched`
-/// flags, out of line: the loop
-/// over all pairs then keeps its registers for the pairs that do not touch, the great majority.
+/// The force of the contact in slot `k` of `s` (separation `r`, overlapping), its run guard
+/// and its particles' `touched` flags, out of line: the loop over all pairs then keeps its
+/// registers for the pairs that do not touch, the great majority.
 ///
 /// # Safety
-/// As [`pair_force`].
+/// As [`pair_force`] for the pair in slot `k`.
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 unsafe fn contact<L: ContactLaw>(
     view: &PairView<'_, L>,
     touched: &[AtomicBool],
-    p: usize,
-    i: usize,
     r: Vec3,
     k: usize,
     s: &mut PairSlots<'_, L::History>,
     watch: &mut Watch,
 ) {
+    let (p, i) = (s.p[k] as usize, s.i[k] as usize);
     let (history, active, out) = (&mut s.history[k], &mut s.active[k], &mut s.out[k]);
     let Some(touch) = evaluate(view, p, i, r, (history, active, out)) else {
         return;
@@ -314,8 +313,7 @@ fn finite(o: &PairForce) -> bool {
 /// infinity when the force or torques are not finite; books the step's work in the account and
 /// raises `watch.pumped` to its excess as a fraction of what it took; and adds a wall's work on
 /// its free partner over this step, F·U·dt with F the force on the free particle and U the
-/// wall's velocity. Inline, with no call in the pair loop: a call there makes the loop keep its
-/// invariants in memory for every pair, touching or not.
+/// wall's velocity. Part of [`contact`], off the loop over all pairs.
 ///
 /// # Safety
 /// As [`pair_force`].
