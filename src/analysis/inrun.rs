@@ -95,13 +95,7 @@ impl Inrun {
                 sampling.every
             );
         }
-        let domain = Domain::new(domain.lo, domain.hi, o.periodic);
-        let grid = Grid {
-            z0: domain.lo.z,
-            z1: domain.hi.z,
-            n: o.slices,
-        };
-        let kernel = o.kernel_for(&grid);
+        let (domain, grid, kernel) = o.frame(domain.lo, domain.hi);
         let l = domain.lengths();
         Ok(Inrun {
             sampling,

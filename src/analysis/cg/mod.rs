@@ -86,9 +86,22 @@ impl CgOptions {
 }
 
 impl CgOptions {
-    /// The kernel of these options on `grid`: Heaviside slices of the grid's height, or a Gauss
-    /// or Lucy kernel of `width` (default the slice height).
-    pub fn kernel_for(&self, grid: &Grid) -> Kernel {
+    /// Where and how these options coarse-grain a box from `lo` to `hi` (length): the box with
+    /// these options' periodic axes, `slices` slices along z, and the kernel on them (Heaviside
+    /// slices of the slices' height, or a Gauss or Lucy kernel of `width`, default the slice
+    /// height). The saves' coarse-graining and in-run averaging both take it from here.
+    pub fn frame(&self, lo: crate::Vec3, hi: crate::Vec3) -> (Domain, Grid, Kernel) {
+        let grid = Grid {
+            z0: lo.z,
+            z1: hi.z,
+            n: self.slices,
+        };
+        let kernel = self.kernel_on(&grid);
+        (Domain::new(lo, hi, self.periodic), grid, kernel)
+    }
+
+    /// The kernel of these options on `grid` (see [`CgOptions::frame`]).
+    fn kernel_on(&self, grid: &Grid) -> Kernel {
         let h = grid.h();
         let width = self.width.unwrap_or(h);
         match self.kernel {
@@ -273,13 +286,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         );
     }
     let head = mercury::read_data(&series.path("data", saves[0]))?;
-    let domain = Domain::new(head.domain_lo, head.domain_hi, o.periodic);
-    let grid = Grid {
-        z0: head.domain_lo.z,
-        z1: head.domain_hi.z,
-        n: o.slices,
-    };
-    let kernel = o.kernel_for(&grid);
+    let (domain, grid, kernel) = o.frame(head.domain_lo, head.domain_hi);
     let walls = o.walls;
     let is_wall = move |i: usize| i < walls;
     let per: Vec<anyhow::Result<(Raw, [crate::Vec3; 2])>> = saves
