@@ -27,10 +27,15 @@ pub(super) struct Kick<'a> {
 /// along periodic axes over the drifts to `gravity_work`, in fixed point
 /// ([`super::energy::fixed`]).
 ///
+/// Two loops: the kicks, then the drift of every particle. Without gravity a closing kick only
+/// visits the particles that touched something or are not yet quiet (found eight flags at a
+/// time); the drift x += v·dt of every particle is one uniform loop over the coordinates. Each
+/// particle's arithmetic is the same as in one fused loop, so the bits are too.
+///
 /// # Safety
 /// `arr` is valid (taken after the last rebuild); no other thread touches particles `a..b`
 /// during the call; with `kick_end`, every pair chunk holding a pair of these particles is done
-/// and no thread writes those pairs' slots.
+/// and no thread writes those pairs' slots or these particles' `touched` flags.
 #[inline(never)]
 pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     k: &Kick<'_>,
@@ -42,111 +47,227 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     gravity_work: &mut i128,
 ) -> [f64; 2] {
     let dt = k.dt;
-    // Four running maxima of each kind, one per lane j mod 4: a single one would chain every
-    // particle's comparison to the previous one's.
-    let mut vmax2 = [[0.0f64; 4]; 2];
-    let mut see = |class: usize, j: usize, vp: Vec3| {
-        let s2 = vp.norm_squared();
-        let lane = &mut vmax2[class][j & 3];
-        if s2 > *lane {
-            *lane = s2;
-        }
-    };
     // Plain slices of this chunk: bounds and base pointers stay in registers.
     let x = arr.x.slice_mut(a..b);
     let v = arr.v.slice_mut(a..b);
     let w = arr.w.slice_mut(a..b);
     let f = arr.f.slice_mut(a..b);
     let t = arr.t.slice_mut(a..b);
-    let quiet = arr.quiet.slice_mut(a..b);
+    // Read eight at a time below as well as one at a time here: a raw pointer, no reference.
+    let quiet = arr.quiet.slice_mut(a..b).as_mut_ptr();
     let inv_mass = arr.inv_mass.slice(a..b);
     let inv_inertia = arr.inv_inertia.slice(a..b);
     let touched = arr.touched.slice(a..b);
-    let near_face = arr.near_face.slice(a..b);
-    let kind = arr.kind.slice(a..b);
-    // Each particle's values are loaded once into locals and stored once: a store followed by
-    // an overlapping wider load of the same vector stalls store forwarding.
-    for j in 0..x.len() {
+    // The half kicks of particle `j` if it is free: the closing one (with `kick_end`; its pair forces
+    // gathered when it touched something) and the opening one (with `drift`).
+    let mut kick = |j: usize, contact: bool| {
         let im = inv_mass[j];
-        let drift_to = |vp: Vec3, xj: Vec3| {
-            let mut xp = xj + vp * dt;
-            if near_face[j] {
-                k.domain.wrap(&mut xp);
-            }
-            xp
-        };
-        if im > 0.0 {
-            // load, then store only if set: a swap would be a locked instruction
-            let contact = kick_end && touched[j].load(Ordering::Relaxed);
-            if !GRAV && kick_end && !contact {
-                // Free flight: F = T = 0 exactly, so both half kicks add +0; (v + 0) + 0 = v + 0
-                // bit for bit, which is v itself once v has absorbed one +0 (quiet).
-                if !quiet[j] {
-                    f[j] = Vec3::zeros();
-                    t[j] = Vec3::zeros();
-                    v[j] += Vec3::zeros();
-                    if ROT {
-                        w[j] += Vec3::zeros();
-                    }
-                    quiet[j] = true;
+        if im <= 0.0 {
+            // a prescribed particle has nothing to kick
+            *quiet.add(j) = true;
+            return;
+        }
+        if !GRAV && kick_end && !contact {
+            // Free flight: F = T = 0 exactly, so both half kicks add +0; (v + 0) + 0 = v + 0
+            // bit for bit, which is v itself once v has absorbed one +0 (quiet).
+            if !*quiet.add(j) {
+                f[j] = Vec3::zeros();
+                t[j] = Vec3::zeros();
+                v[j] += Vec3::zeros();
+                if ROT {
+                    w[j] += Vec3::zeros();
                 }
-                if drift {
-                    let vp = v[j];
-                    x[j] = drift_to(vp, x[j]);
-                    see(kind[j] as usize, j, vp);
-                }
-                continue;
+                *quiet.add(j) = true;
             }
-            quiet[j] = false;
-            let (fp, tp) = if kick_end {
-                let g = if contact {
-                    touched[j].store(false, Ordering::Relaxed);
-                    gather(a + j, arr)
-                } else {
-                    (Vec3::zeros(), Vec3::zeros())
-                };
-                f[j] = g.0;
-                t[j] = g.1;
-                g
+            return;
+        }
+        *quiet.add(j) = false;
+        let (fp, tp) = if kick_end {
+            let g = if contact {
+                touched[j].store(false, Ordering::Relaxed);
+                gather(a + j, arr)
             } else {
-                (f[j], t[j])
+                (Vec3::zeros(), Vec3::zeros())
             };
-            // Half kick v += (F/m + g)·dt/2, ω += T/I·dt/2, in MercuryDPM's order of operations
-            // (BaseParticle::integrateBeforeForceComputation); the closing kick of one step and
-            // the opening kick of the next add the same increment twice.
-            let acc = if GRAV { fp * im + k.gravity } else { fp * im };
-            let dv = acc * 0.5 * dt;
-            let mut vp = v[j];
+            f[j] = g.0;
+            t[j] = g.1;
+            g
+        } else {
+            (f[j], t[j])
+        };
+        // Half kick v += (F/m + g)·dt/2, ω += T/I·dt/2, in MercuryDPM's order of operations
+        // (BaseParticle::integrateBeforeForceComputation); the closing kick of one step and
+        // the opening kick of the next add the same increment twice.
+        let acc = if GRAV { fp * im + k.gravity } else { fp * im };
+        let dv = acc * 0.5 * dt;
+        let mut vp = v[j];
+        if kick_end {
+            vp += dv;
+        }
+        if drift {
+            vp += dv;
+            if let (true, Some(g)) = (GRAV, k.periodic_gravity) {
+                *gravity_work += super::energy::fixed(g.dot(&vp) * dt / im);
+            }
+        }
+        v[j] = vp;
+        if ROT {
+            let dw = tp * inv_inertia[j] * 0.5 * dt;
+            let mut wp = w[j];
             if kick_end {
-                vp += dv;
+                wp += dw;
             }
             if drift {
-                vp += dv;
-                x[j] = drift_to(vp, x[j]);
-                see(kind[j] as usize, j, vp);
-                if let (true, Some(g)) = (GRAV, k.periodic_gravity) {
-                    *gravity_work += super::energy::fixed(g.dot(&vp) * dt / im);
-                }
+                wp += dw;
             }
-            v[j] = vp;
-            if ROT {
-                let dw = tp * inv_inertia[j] * 0.5 * dt;
-                let mut wp = w[j];
-                if kick_end {
-                    wp += dw;
-                }
-                if drift {
-                    wp += dw;
-                }
-                w[j] = wp;
-            }
-        } else if drift {
-            let vp = v[j];
-            x[j] = drift_to(vp, x[j]);
-            see(kind[j] as usize, j, vp);
+            w[j] = wp;
+        }
+    };
+    if !GRAV && kick_end {
+        // SAFETY: no thread writes these flags during the call (see above), so reading them
+        // eight at a time, without atomic loads, races with nothing; `AtomicBool` has the
+        // layout of `bool`, one byte that is 0 or 1.
+        let (set, clear) = (
+            touched.as_ptr().cast::<u8>(),
+            quiet.cast::<u8>().cast_const(),
+        );
+        for_each_set(set, Some(clear), b - a, |j| {
+            kick(j, touched[j].load(Ordering::Relaxed))
+        });
+    } else {
+        for j in 0..x.len() {
+            kick(j, kick_end && touched[j].load(Ordering::Relaxed));
         }
     }
-    vmax2.map(|lanes| lanes.into_iter().fold(0.0, f64::max))
+    if !drift {
+        return [0.0; 2];
+    }
+    let speeds = drift_all(x, v, arr.kind.slice(a..b), dt);
+    let near_face = arr.near_face.slice(a..b).as_ptr().cast::<u8>();
+    for_each_set(near_face, None, b - a, |j| k.domain.wrap(&mut x[j]));
+    speeds
+}
+
+/// Calls `visit(j)` for every `j < n` where byte `set[j]` is not 0 or, with `clear`, byte
+/// `clear[j]` is 0, in increasing order; the flags (bytes 0 or 1) are read eight at a time
+/// before `visit` is called for any of the eight, so `visit` may change them.
+///
+/// # Safety
+/// `set` and `clear` point to `n` readable bytes each that no other thread writes during the
+/// call.
+#[inline(always)]
+unsafe fn for_each_set(
+    set: *const u8,
+    clear: Option<*const u8>,
+    n: usize,
+    mut visit: impl FnMut(usize),
+) {
+    let ones = u64::from_le_bytes([1; 8]);
+    let word =
+        |flags: *const u8, j: usize| u64::from_le_bytes(flags.add(j).cast::<[u8; 8]>().read());
+    let mut j = 0;
+    while j + 8 <= n {
+        let mut hits = word(set, j);
+        if let Some(clear) = clear {
+            hits |= word(clear, j) ^ ones;
+        }
+        while hits != 0 {
+            let byte = hits.trailing_zeros() as usize / 8;
+            visit(j + byte);
+            hits &= !(0xff << (8 * byte));
+        }
+        j += 8;
+    }
+    for j in j..n {
+        if *set.add(j) != 0 || clear.is_some_and(|c| *c.add(j) == 0) {
+            visit(j);
+        }
+    }
+}
+
+/// The drift x += v·dt of every particle of a chunk, in place; returns the largest squared
+/// speed |v|² of a particle of kind 0 [0] and of kind 1 [1] (0 for none). Squared speeds sum
+/// (vx² + vy²) + vz², as `Vec3::norm_squared`; a NaN one counts for no maximum.
+#[inline(always)]
+fn drift_all(x: &mut [Vec3], v: &[Vec3], kind: &[u8], dt: f64) -> [f64; 2] {
+    const _: () = assert!(std::mem::size_of::<Vec3>() == 3 * std::mem::size_of::<f64>());
+    let n = x.len().min(v.len()).min(kind.len());
+    // SAFETY: SSE2 is part of the x86-64 baseline; `Vec3` is three contiguous f64.
+    #[cfg(target_arch = "x86_64")]
+    let (done, lanes) =
+        unsafe { sse2::drift_pairs(x.as_mut_ptr().cast(), v.as_ptr().cast(), kind, n / 2, dt) };
+    #[cfg(not(target_arch = "x86_64"))]
+    let (done, lanes) = (0, [[0.0f64; 2]; 2]);
+    let mut vmax2 = [0.0f64; 2];
+    for j in done..n {
+        let vp = v[j];
+        x[j] += vp * dt;
+        let s2 = vp.norm_squared();
+        let m = &mut vmax2[usize::from(kind[j] != 0)];
+        if s2 > *m {
+            *m = s2;
+        }
+    }
+    std::array::from_fn(|c| lanes[c].iter().fold(vmax2[c], |m, &l| m.max(l)))
+}
+
+/// The drift two particles at a time on SSE2: the same operations as the scalar loop, two
+/// lanes wide.
+#[cfg(target_arch = "x86_64")]
+mod sse2 {
+    use std::arch::x86_64::*;
+
+    /// Drifts the first `2 * pairs` particles of the coordinates `x` by the velocities `v`
+    /// (three f64 each) over `dt`; returns how many it drifted and the largest squared speeds
+    /// by kind, each in two lanes.
+    ///
+    /// # Safety
+    /// `x` and `v` hold `6 * pairs` f64 each and do not overlap; `kind` has `2 * pairs`
+    /// entries at least.
+    #[inline(always)]
+    pub(super) unsafe fn drift_pairs(
+        x: *mut f64,
+        v: *const f64,
+        kind: &[u8],
+        pairs: usize,
+        dt: f64,
+    ) -> (usize, [[f64; 2]; 2]) {
+        let step = _mm_set1_pd(dt);
+        let mut slow = _mm_setzero_pd();
+        let mut fast = _mm_setzero_pd();
+        for q in 0..pairs {
+            let (xq, vq) = (x.add(6 * q), v.add(6 * q));
+            // particle 2q is (v0.0, v0.1, v1.0), particle 2q+1 is (v1.1, v2.0, v2.1)
+            let v0 = _mm_loadu_pd(vq);
+            let v1 = _mm_loadu_pd(vq.add(2));
+            let v2 = _mm_loadu_pd(vq.add(4));
+            _mm_storeu_pd(xq, _mm_add_pd(_mm_loadu_pd(xq), _mm_mul_pd(v0, step)));
+            _mm_storeu_pd(
+                xq.add(2),
+                _mm_add_pd(_mm_loadu_pd(xq.add(2)), _mm_mul_pd(v1, step)),
+            );
+            _mm_storeu_pd(
+                xq.add(4),
+                _mm_add_pd(_mm_loadu_pd(xq.add(4)), _mm_mul_pd(v2, step)),
+            );
+            let (s0, s1, s2) = (_mm_mul_pd(v0, v0), _mm_mul_pd(v1, v1), _mm_mul_pd(v2, v2));
+            let xx = _mm_shuffle_pd::<0b10>(s0, s1);
+            let yy = _mm_shuffle_pd::<0b01>(s0, s2);
+            let zz = _mm_shuffle_pd::<0b10>(s1, s2);
+            let speed2 = _mm_add_pd(_mm_add_pd(xx, yy), zz);
+            let is_fast = _mm_castsi128_pd(_mm_set_epi64x(
+                -i64::from(kind[2 * q + 1] != 0),
+                -i64::from(kind[2 * q] != 0),
+            ));
+            // max(a, b) is a > b ? a : b, so a NaN speed leaves the maximum as it was
+            fast = _mm_max_pd(_mm_and_pd(is_fast, speed2), fast);
+            slow = _mm_max_pd(_mm_andnot_pd(is_fast, speed2), slow);
+        }
+        let mut lanes = [[0.0; 2]; 2];
+        _mm_storeu_pd(lanes[0].as_mut_ptr(), slow);
+        _mm_storeu_pd(lanes[1].as_mut_ptr(), fast);
+        (2 * pairs, lanes)
+    }
 }
 
 /// Sum of the forces and torques of particle `a`'s active pairs, in the order of partner ids.
