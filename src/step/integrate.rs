@@ -187,55 +187,76 @@ unsafe fn for_each_set(
 
 /// The drift x += v·dt of every particle of a chunk, in place; returns the largest squared
 /// speed |v|² of a particle of kind 0 [0] and of kind 1 [1] (0 for none). Squared speeds sum
-/// (vx² + vy²) + vz², as `Vec3::norm_squared`; a NaN one counts for no maximum.
+/// (vx² + vy²) + vz², as `Vec3::norm_squared`; a NaN one counts for no maximum. Four particles
+/// at a time with AVX2 where the CPU has it, then two at a time with SSE2 (the x86-64
+/// baseline), then one at a time: the same operations on each particle in every path, and no
+/// fused multiply–add, so the same bits.
 #[inline(always)]
 fn drift_all(x: &mut [Vec3], v: &[Vec3], kind: &[u8], dt: f64) -> [f64; 2] {
     const _: () = assert!(std::mem::size_of::<Vec3>() == 3 * std::mem::size_of::<f64>());
     let n = x.len().min(v.len()).min(kind.len());
-    // SAFETY: SSE2 is part of the x86-64 baseline; `Vec3` is three contiguous f64.
+    let mut top = [0.0f64; 2];
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
+    let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    let (done, lanes) =
-        unsafe { sse2::drift_pairs(x.as_mut_ptr().cast(), v.as_ptr().cast(), kind, n / 2, dt) };
-    #[cfg(not(target_arch = "x86_64"))]
-    let (done, lanes) = (0, [[0.0f64; 2]; 2]);
-    let mut vmax2 = [0.0f64; 2];
+    {
+        let (xs, vs) = (x.as_mut_ptr().cast::<f64>(), v.as_ptr().cast::<f64>());
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2; `Vec3` is three contiguous f64, so `x` and `v` hold
+            // 3n of them.
+            done = unsafe { simd::drift_fours(xs, vs, kind, n / 4, dt, &mut top) };
+        }
+        // SAFETY: SSE2 is part of the x86-64 baseline; as above.
+        done += unsafe {
+            simd::drift_twos(
+                xs.add(3 * done),
+                vs.add(3 * done),
+                &kind[done..],
+                (n - done) / 2,
+                dt,
+                &mut top,
+            )
+        };
+    }
     for j in done..n {
         let vp = v[j];
         x[j] += vp * dt;
         let s2 = vp.norm_squared();
-        let m = &mut vmax2[usize::from(kind[j] != 0)];
+        let m = &mut top[usize::from(kind[j] != 0)];
         if s2 > *m {
             *m = s2;
         }
     }
-    std::array::from_fn(|c| lanes[c].iter().fold(vmax2[c], |m, &l| m.max(l)))
+    top
 }
 
-/// The drift two particles at a time on SSE2: the same operations as the scalar loop, two
-/// lanes wide.
+/// The drift several particles at a time: the operations of the scalar loop, lane by lane.
+/// `max(a, b)` below is `a > b ? a : b` (MAXPD), so a NaN squared speed leaves a maximum as it
+/// was, as in the scalar loop.
 #[cfg(target_arch = "x86_64")]
-mod sse2 {
+mod simd {
     use std::arch::x86_64::*;
 
-    /// Drifts the first `2 * pairs` particles of the coordinates `x` by the velocities `v`
-    /// (three f64 each) over `dt`; returns how many it drifted and the largest squared speeds
-    /// by kind, each in two lanes.
+    /// Drifts the first `2 * count` particles of the coordinates `x` by the velocities `v`
+    /// (three f64 each) over `dt`; raises `top` to the largest squared speeds by kind. Returns
+    /// the number of particles drifted.
     ///
     /// # Safety
-    /// `x` and `v` hold `6 * pairs` f64 each and do not overlap; `kind` has `2 * pairs`
+    /// `x` and `v` hold `6 * count` f64 each and do not overlap; `kind` has `2 * count`
     /// entries at least.
     #[inline(always)]
-    pub(super) unsafe fn drift_pairs(
+    pub(super) unsafe fn drift_twos(
         x: *mut f64,
         v: *const f64,
         kind: &[u8],
-        pairs: usize,
+        count: usize,
         dt: f64,
-    ) -> (usize, [[f64; 2]; 2]) {
+        top: &mut [f64; 2],
+    ) -> usize {
         let step = _mm_set1_pd(dt);
         let mut slow = _mm_setzero_pd();
         let mut fast = _mm_setzero_pd();
-        for q in 0..pairs {
+        for q in 0..count {
             let (xq, vq) = (x.add(6 * q), v.add(6 * q));
             // particle 2q is (v0.0, v0.1, v1.0), particle 2q+1 is (v1.1, v2.0, v2.1)
             let v0 = _mm_loadu_pd(vq);
@@ -259,14 +280,78 @@ mod sse2 {
                 -i64::from(kind[2 * q + 1] != 0),
                 -i64::from(kind[2 * q] != 0),
             ));
-            // max(a, b) is a > b ? a : b, so a NaN speed leaves the maximum as it was
             fast = _mm_max_pd(_mm_and_pd(is_fast, speed2), fast);
             slow = _mm_max_pd(_mm_andnot_pd(is_fast, speed2), slow);
         }
         let mut lanes = [[0.0; 2]; 2];
         _mm_storeu_pd(lanes[0].as_mut_ptr(), slow);
         _mm_storeu_pd(lanes[1].as_mut_ptr(), fast);
-        (2 * pairs, lanes)
+        for (t, l) in top.iter_mut().zip(lanes) {
+            *t = l.into_iter().fold(*t, f64::max);
+        }
+        2 * count
+    }
+
+    /// As [`drift_twos`], four particles at a time.
+    ///
+    /// # Safety
+    /// As [`drift_twos`] with `12 * count` f64 and `4 * count` kinds; the CPU has AVX2.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn drift_fours(
+        x: *mut f64,
+        v: *const f64,
+        kind: &[u8],
+        count: usize,
+        dt: f64,
+        top: &mut [f64; 2],
+    ) -> usize {
+        let step = _mm256_set1_pd(dt);
+        let mut slow = _mm256_setzero_pd();
+        let mut fast = _mm256_setzero_pd();
+        let kinds = kind.as_ptr();
+        for q in 0..count {
+            let (xq, vq) = (x.add(12 * q), v.add(12 * q));
+            // v0 = (x0 y0 z0 x1), v1 = (y1 z1 x2 y2), v2 = (z2 x3 y3 z3)
+            let v0 = _mm256_loadu_pd(vq);
+            let v1 = _mm256_loadu_pd(vq.add(4));
+            let v2 = _mm256_loadu_pd(vq.add(8));
+            for (k, vk) in [v0, v1, v2].into_iter().enumerate() {
+                let xk = xq.add(4 * k);
+                _mm256_storeu_pd(
+                    xk,
+                    _mm256_add_pd(_mm256_loadu_pd(xk), _mm256_mul_pd(vk, step)),
+                );
+            }
+            let (s0, s1, s2) = (
+                _mm256_mul_pd(v0, v0),
+                _mm256_mul_pd(v1, v1),
+                _mm256_mul_pd(v2, v2),
+            );
+            // squares regrouped by component: (x0 y0 | y3 z3), (z0 x1 | z2 x3)
+            let ends = _mm256_permute2f128_pd::<0x30>(s0, s2);
+            let mid = _mm256_permute2f128_pd::<0x21>(s0, s2);
+            let p = _mm256_blend_pd::<0b1100>(ends, s1); // (x0 y0 | x2 y2)
+            let q2 = _mm256_blend_pd::<0b1100>(s1, ends); // (y1 z1 | y3 z3)
+            let xx = _mm256_shuffle_pd::<0b1010>(p, mid);
+            let yy = _mm256_shuffle_pd::<0b0101>(p, q2);
+            let zz = _mm256_shuffle_pd::<0b1010>(mid, q2);
+            let speed2 = _mm256_add_pd(_mm256_add_pd(xx, yy), zz);
+            // kinds 0 or 1 → lanes of all zeros or all ones
+            let k4 = _mm_cvtsi32_si128(kinds.add(4 * q).cast::<i32>().read_unaligned());
+            let is_fast = _mm256_castsi256_pd(_mm256_sub_epi64(
+                _mm256_setzero_si256(),
+                _mm256_cvtepu8_epi64(k4),
+            ));
+            fast = _mm256_max_pd(_mm256_and_pd(is_fast, speed2), fast);
+            slow = _mm256_max_pd(_mm256_andnot_pd(is_fast, speed2), slow);
+        }
+        let mut lanes = [[0.0; 4]; 2];
+        _mm256_storeu_pd(lanes[0].as_mut_ptr(), slow);
+        _mm256_storeu_pd(lanes[1].as_mut_ptr(), fast);
+        for (t, l) in top.iter_mut().zip(lanes) {
+            *t = l.into_iter().fold(*t, f64::max);
+        }
+        4 * count
     }
 }
 
