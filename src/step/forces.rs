@@ -169,15 +169,89 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     mut s: PairSlots<'_, L::History>,
 ) -> Watch {
     let mut watch = Watch::default();
-    for k in 0..s.p.len() {
+    let mut visit = |k: usize, s: &mut PairSlots<'_, L::History>| {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let Some(r) = touching::<L, PERIODIC>(view, p, i) else {
             forget(&mut s.history[k], &mut s.active[k]);
-            continue;
+            return;
         };
-        contact(view, touched, r, k, &mut s, &mut watch);
+        contact(view, touched, r, k, s, &mut watch);
+    };
+    let n = s.p.len().min(s.i.len()).min(s.active.len());
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
+    let mut k = 0;
+    #[cfg(target_arch = "x86_64")]
+    if !PERIODIC {
+        // Four interior pairs at a time: those of which none touches and none was active, the
+        // great majority, have nothing to do.
+        let (x, radius) = (view.x.slice(0..view.radius.len()), view.radius);
+        while k + 4 <= n {
+            // SAFETY: `k + 4 <= n`; the pair's indices are particles of the views.
+            if simd::any_of_four(x, radius, s.p, s.i, s.active, k) {
+                for k in k..k + 4 {
+                    visit(k, &mut s);
+                }
+            }
+            k += 4;
+        }
+    }
+    for k in k..n {
+        visit(k, &mut s);
     }
     watch
+}
+
+/// The distance test of interior pairs, several at a time.
+#[cfg(target_arch = "x86_64")]
+mod simd {
+    use std::arch::x86_64::*;
+
+    use crate::Vec3;
+
+    /// Whether any of the pairs `k..k + 4` (particles `p`, `i`) touches,
+    /// |x_P − x_I|² < (r_P + r_I)² as [`super::touching`] computes it without a periodic image
+    /// (squares summed (x² + y²) + z²), or was active.
+    ///
+    /// # Safety
+    /// `k + 4` is at most the length of `p`, `i` and `active`; their particles index `x` and
+    /// `radius`.
+    #[inline(always)]
+    pub(super) unsafe fn any_of_four(
+        x: &[Vec3],
+        radius: &[f64],
+        p: &[u32],
+        i: &[u32],
+        active: &[bool],
+        k: usize,
+    ) -> bool {
+        let (x, radius) = (x.as_ptr().cast::<f64>(), radius.as_ptr());
+        // (x, y) and z of x_P − x_I, and r_P + r_I, of pair m
+        let pair = |m: usize| {
+            let (a, b) = (
+                *p.get_unchecked(k + m) as usize,
+                *i.get_unchecked(k + m) as usize,
+            );
+            let (xa, xb) = (x.add(3 * a), x.add(3 * b));
+            let xy = _mm_sub_pd(_mm_loadu_pd(xa), _mm_loadu_pd(xb));
+            let z = _mm_sub_sd(_mm_load_sd(xa.add(2)), _mm_load_sd(xb.add(2)));
+            let sum = _mm_add_sd(_mm_load_sd(radius.add(a)), _mm_load_sd(radius.add(b)));
+            (xy, z, sum)
+        };
+        // bit m set when pair m of the two touches
+        let two = |m: usize| {
+            let ((xy0, z0, r0), (xy1, z1, r1)) = (pair(m), pair(m + 1));
+            let (s0, s1) = (_mm_mul_pd(xy0, xy0), _mm_mul_pd(xy1, xy1));
+            let z = _mm_unpacklo_pd(z0, z1);
+            let d2 = _mm_add_pd(
+                _mm_add_pd(_mm_unpacklo_pd(s0, s1), _mm_unpackhi_pd(s0, s1)),
+                _mm_mul_pd(z, z),
+            );
+            let reach = _mm_unpacklo_pd(r0, r1);
+            _mm_movemask_pd(_mm_cmplt_pd(d2, _mm_mul_pd(reach, reach)))
+        };
+        let was = active.as_ptr().add(k).cast::<u32>().read_unaligned();
+        (two(0) | two(2)) != 0 || was != 0
+    }
 }
 
 /// Force of pair (p, i) into its slot (history, active flag, force); a pair that is not
