@@ -181,13 +181,14 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     #[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut))]
     let mut k = 0;
     #[cfg(target_arch = "x86_64")]
-    if !PERIODIC {
-        // Four interior pairs at a time: those of which none touches and none was active, the
-        // great majority, have nothing to do.
+    {
+        // Four pairs at a time: those of which none touches and none was active, the great
+        // majority, have nothing to do.
         let (x, radius) = (view.x.slice(0..view.radius.len()), view.radius);
+        let period = view.domain.period();
         while k + 4 <= n {
             // SAFETY: `k + 4 <= n`; the pair's indices are particles of the views.
-            if simd::any_of_four(x, radius, s.p, s.i, s.active, k) {
+            if simd::any_of_four::<PERIODIC>(x, radius, period, s.p, s.i, s.active, k) {
                 for k in k..k + 4 {
                     visit(k, &mut s);
                 }
@@ -209,22 +210,32 @@ mod simd {
     use crate::Vec3;
 
     /// Whether any of the pairs `k..k + 4` (particles `p`, `i`) touches,
-    /// |x_P − x_I|² < (r_P + r_I)² as [`super::touching`] computes it without a periodic image
-    /// (squares summed (x² + y²) + z²), or was active.
+    /// |x_P − x_I|² < (r_P + r_I)² as [`super::touching`] computes it (squares summed
+    /// (x² + y²) + z²; with `PERIODIC`, the minimum image of [`crate::state::Domain::min_image`]
+    /// for the periods `period`), or was active.
     ///
     /// # Safety
     /// `k + 4` is at most the length of `p`, `i` and `active`; their particles index `x` and
     /// `radius`.
     #[inline(always)]
-    pub(super) unsafe fn any_of_four(
+    pub(super) unsafe fn any_of_four<const PERIODIC: bool>(
         x: &[Vec3],
         radius: &[f64],
+        period: Vec3,
         p: &[u32],
         i: &[u32],
         active: &[bool],
         k: usize,
     ) -> bool {
         let (x, radius) = (x.as_ptr().cast::<f64>(), radius.as_ptr());
+        // d − L·([d > L/2] − [d < −L/2]) lane by lane, as `Domain::min_image`
+        let image = |d: __m128d, l: __m128d| {
+            let one = _mm_set1_pd(1.0);
+            let up = _mm_and_pd(_mm_cmpgt_pd(d, _mm_mul_pd(_mm_set1_pd(0.5), l)), one);
+            let down = _mm_and_pd(_mm_cmplt_pd(d, _mm_mul_pd(_mm_set1_pd(-0.5), l)), one);
+            _mm_sub_pd(d, _mm_mul_pd(l, _mm_sub_pd(up, down)))
+        };
+        let (l_xy, l_z) = (_mm_set_pd(period.y, period.x), _mm_set1_pd(period.z));
         // (x, y) and z of x_P − x_I, and r_P + r_I, of pair m
         let pair = |m: usize| {
             let (a, b) = (
@@ -235,13 +246,18 @@ mod simd {
             let xy = _mm_sub_pd(_mm_loadu_pd(xa), _mm_loadu_pd(xb));
             let z = _mm_sub_sd(_mm_load_sd(xa.add(2)), _mm_load_sd(xb.add(2)));
             let sum = _mm_add_sd(_mm_load_sd(radius.add(a)), _mm_load_sd(radius.add(b)));
-            (xy, z, sum)
+            if PERIODIC {
+                (image(xy, l_xy), z, sum)
+            } else {
+                (xy, z, sum)
+            }
         };
         // bit m set when pair m of the two touches
         let two = |m: usize| {
             let ((xy0, z0, r0), (xy1, z1, r1)) = (pair(m), pair(m + 1));
             let (s0, s1) = (_mm_mul_pd(xy0, xy0), _mm_mul_pd(xy1, xy1));
             let z = _mm_unpacklo_pd(z0, z1);
+            let z = if PERIODIC { image(z, l_z) } else { z };
             let d2 = _mm_add_pd(
                 _mm_add_pd(_mm_unpacklo_pd(s0, s1), _mm_unpackhi_pd(s0, s1)),
                 _mm_mul_pd(z, z),
