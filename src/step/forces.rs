@@ -462,3 +462,83 @@ unsafe fn overlap<L, const PERIODIC: bool>(view: &PairView<'_, L>, p: usize, i: 
     };
     view.radius[p] + view.radius[i] - r.norm()
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::state::Domain;
+    use crate::Vec3;
+
+    /// The four-pair test finds a block to visit exactly when the per-pair test would: some pair
+    /// touches (|x_P − x_I|² < (r_P + r_I)², with the minimum image for periodic pairs) or was
+    /// active; pairs at exactly touching distance, across the periodic faces and far apart.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn four_pairs_at_a_time_find_the_blocks_one_pair_at_a_time_finds() {
+        let domain = Domain::new(
+            Vec3::zeros(),
+            Vec3::new(20.0, 10.3923048454133, 22.0),
+            [true, true, false],
+        );
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |scale: f64| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            scale * ((seed >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let n = 400;
+        let mut x: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(next(20.0), next(10.3923048454133), next(22.0)))
+            .collect();
+        let radius: Vec<f64> = (0..n).map(|_| 0.5 + next(0.1)).collect();
+        // particle 2k+1 sits near particle 2k: closer, at, or just beyond touching, or across a face
+        for k in 0..n / 2 {
+            let (a, b) = (2 * k, 2 * k + 1);
+            let sum = radius[a] + radius[b];
+            let d = [0.9 * sum, sum, 1.0000001 * sum, 3.0 * sum][k % 4];
+            x[b] = x[a] + Vec3::new(d, 0.0, 0.0);
+            if k % 3 == 0 {
+                x[b].x -= 20.0;
+            }
+        }
+        let p: Vec<u32> = (0..n as u32)
+            .step_by(2)
+            .chain((0..n as u32).step_by(3))
+            .collect();
+        let i: Vec<u32> = (1..n as u32)
+            .step_by(2)
+            .chain((1..n as u32).step_by(3))
+            .collect();
+        let m = p.len().min(i.len()) / 4 * 4;
+        let active: Vec<bool> = (0..m).map(|k| k % 37 == 5).collect();
+        let touches = |k: usize, periodic: bool| {
+            let (a, b) = (p[k] as usize, i[k] as usize);
+            let direct = x[a] - x[b];
+            let r = if periodic {
+                domain.min_image(direct)
+            } else {
+                direct
+            };
+            let sum = radius[a] + radius[b];
+            r.norm_squared() < sum * sum
+        };
+        let mut visited = [0, 0];
+        for k in (0..m).step_by(4) {
+            let want = |periodic| (k..k + 4).any(|k| touches(k, periodic) || active[k]);
+            let period = domain.period();
+            // SAFETY: k + 4 <= m; every index is below n.
+            let got = unsafe {
+                [
+                    super::simd::any_of_four::<false>(&x, &radius, period, &p, &i, &active, k),
+                    super::simd::any_of_four::<true>(&x, &radius, period, &p, &i, &active, k),
+                ]
+            };
+            assert_eq!(got, [want(false), want(true)], "block at {k}");
+            for (v, g) in visited.iter_mut().zip(got) {
+                *v += usize::from(g);
+            }
+        }
+        // both kinds of block occur, and the image makes a difference
+        assert!(visited[0] > 0 && visited[1] > visited[0] && visited[1] < m / 4);
+    }
+}
