@@ -92,7 +92,8 @@ pub struct Flags {
     pub near_face: Vec<bool>,
     /// Whether each particle is quiet: its force and torque slots hold zero and its velocities
     /// have absorbed a +0 kick (no −0 component), so that a free flight changes neither and only
-    /// drifts it. Cleared at every build and at the start of every run.
+    /// drifts it. A prescribed particle is marked quiet at its first particle pass: it has no
+    /// kick. Cleared at every build and at the start of every run.
     pub quiet: Vec<bool>,
     /// Speed class at the last build: 1 for the fast particles (faster than [`SLOW_FRACTION`]
     /// of the fastest free particle, and all prescribed ones), 0 for the others.

@@ -32,6 +32,11 @@ impl Domain {
         }
     }
 
+    /// Period along each axis (length): the edge length on periodic axes, 0 elsewhere.
+    pub fn period(&self) -> Vec3 {
+        self.period
+    }
+
     /// Edge lengths `hi - lo`.
     pub fn lengths(&self) -> Vec3 {
         self.hi - self.lo
