@@ -143,9 +143,29 @@ pub fn coverage(
 /// `blocks` − 1 degrees of freedom, and the fraction is P(|t| ≤ 2/√(1 − 1/R)). Below 95 % for
 /// few blocks (92.3 % for 10 blocks and many replicas), above for few replicas.
 pub fn expected_coverage(replicas: usize, blocks: usize) -> f64 {
+    expected_coverage_dof(replicas, blocks.max(2) as f64 - 1.0)
+}
+
+/// [`expected_coverage`] for errors whose variance is estimated with `dof` degrees of freedom
+/// (at least 1).
+pub fn expected_coverage_dof(replicas: usize, dof: f64) -> f64 {
     let r = replicas.max(2) as f64;
-    let dof = blocks.max(2) as f64 - 1.0;
-    student_t_within(2.0 / (1.0 - 1.0 / r).sqrt(), dof)
+    student_t_within(2.0 / (1.0 - 1.0 / r).sqrt(), dof.max(1.0))
+}
+
+/// The 95 % Wilson score interval of a binomial fraction `inside`/`trials` (Wilson, J. Am.
+/// Stat. Assoc. 22:209, 1927): the fractions p whose |p̂ − p| ≤ 1.96 √(p(1 − p)/n). Taken over
+/// (replica, slice) pairs it is too narrow when neighbouring slices of one replica deviate
+/// together.
+pub fn wilson_interval(inside: usize, trials: usize) -> (f64, f64) {
+    if trials == 0 {
+        return (0.0, 1.0);
+    }
+    let (n, z) = (trials as f64, 1.959964);
+    let p = inside as f64 / n;
+    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
 /// P(|T| ≤ x) for Student's t with `dof` degrees of freedom: twice the integral from 0 to x of
