@@ -247,6 +247,19 @@ mod tests {
     }
 
     #[test]
+    fn the_wilson_interval_matches_its_tables() {
+        // 50 of 100: 0.4038–0.5962; 0 of 10: 0–0.2775 (the rule of three's Wilson form)
+        let (lo, hi) = wilson_interval(50, 100);
+        assert!(
+            (lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = wilson_interval(0, 10);
+        assert!(lo == 0.0 && (hi - 0.2775).abs() < 1e-4, "{hi}");
+        assert_eq!(wilson_interval(0, 0), (0.0, 1.0));
+    }
+
+    #[test]
     fn coverage_counts_replicas_inside_their_own_error() {
         // core means 0, 0, 3 → ensemble 1; deviations −1, −1, +2; errors 0.6, 0.4, 0.9:
         // inside ±2 se for the first (1 ≤ 1.2), outside for the second (1 > 0.8) and third (2 > 1.8)

@@ -413,6 +413,9 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         }
     ));
     out.push_str(&blocking::describe(&r.errors, p.saves.len(), "bins"));
+    if r.errors.floor.iter().any(|&f| f > 0.0) {
+        out.push_str(blocking::SLOW_MODE_NOTE);
+    }
     out.push_str("checks of the in-run profiles:\n");
     let report = checks::report(p, &checks::run(p, r.density));
     // The first line of the saves' report speaks of saves; the in-run one is above, and the
