@@ -287,7 +287,7 @@ pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
                 ": error from tau ({:.1} degrees of freedom)",
                 degrees_of_freedom(errors, c, units)
             ),
-            Method::TooShort => ": TOO SHORT, error not to be trusted (too small)".into(),
+            Method::TooShort => ": TOO SHORT, error not to be trusted".into(),
         };
         s.push_str(&format!(
             "  {name:9} tau {tau}, {} blocks of {:.1} (needs >= {}){how}\n",
