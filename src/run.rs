@@ -154,13 +154,14 @@ pub fn run_files(dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// The files of a run besides its numbered saves, after `NAME.`.
-const OWN_FILES: [&str; 10] = [
+const OWN_FILES: [&str; 11] = [
     "pvd",
     "checkpoint",
     "diagnostics.csv",
     "summary.toml",
     "profiles.csv",
     "profiles_inrun.csv",
+    "profiles_inrun_errors.csv",
     "profiles.png",
     "checks.txt",
     "particles.png",

@@ -143,9 +143,29 @@ pub fn coverage(
 /// `blocks` − 1 degrees of freedom, and the fraction is P(|t| ≤ 2/√(1 − 1/R)). Below 95 % for
 /// few blocks (92.3 % for 10 blocks and many replicas), above for few replicas.
 pub fn expected_coverage(replicas: usize, blocks: usize) -> f64 {
+    expected_coverage_dof(replicas, blocks.max(2) as f64 - 1.0)
+}
+
+/// [`expected_coverage`] for errors whose variance is estimated with `dof` degrees of freedom
+/// (at least 1).
+pub fn expected_coverage_dof(replicas: usize, dof: f64) -> f64 {
     let r = replicas.max(2) as f64;
-    let dof = blocks.max(2) as f64 - 1.0;
-    student_t_within(2.0 / (1.0 - 1.0 / r).sqrt(), dof)
+    student_t_within(2.0 / (1.0 - 1.0 / r).sqrt(), dof.max(1.0))
+}
+
+/// The 95 % Wilson score interval of a binomial fraction `inside`/`trials` (Wilson, J. Am.
+/// Stat. Assoc. 22:209, 1927): the fractions p whose |p̂ − p| ≤ 1.96 √(p(1 − p)/n). Taken over
+/// (replica, slice) pairs it is too narrow when neighbouring slices of one replica deviate
+/// together.
+pub fn wilson_interval(inside: usize, trials: usize) -> (f64, f64) {
+    if trials == 0 {
+        return (0.0, 1.0);
+    }
+    let (n, z) = (trials as f64, 1.959964);
+    let p = inside as f64 / n;
+    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
 /// P(|T| ≤ x) for Student's t with `dof` degrees of freedom: twice the integral from 0 to x of
@@ -224,6 +244,19 @@ mod tests {
                         + 8.0 / 15.0 * c.powi(5)
                         + 48.0 / 105.0 * c.powi(7)));
         assert!((expected_coverage(1_000_000_000, 10) - closed).abs() < 1e-8);
+    }
+
+    #[test]
+    fn the_wilson_interval_matches_its_tables() {
+        // 50 of 100: 0.4038–0.5962; 0 of 10: 0–0.2775 (the rule of three's Wilson form)
+        let (lo, hi) = wilson_interval(50, 100);
+        assert!(
+            (lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = wilson_interval(0, 10);
+        assert!(lo == 0.0 && (hi - 0.2775).abs() < 1e-4, "{hi}");
+        assert_eq!(wilson_interval(0, 0), (0.0, 1.0));
     }
 
     #[test]

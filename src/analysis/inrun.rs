@@ -77,6 +77,21 @@ pub struct Inrun {
     trace: Vec<[f64; 2]>,
     free: usize,
     free_volume: f64,
+    /// The time step, when the errors take no τ below the benchmark's reference
+    /// ([`blocking::REFERENCE_TAU`]).
+    reference_dt: Option<f64>,
+}
+
+/// The default sampling intervals (steps) of a run whose free–free contact lasts `tc_steps`
+/// steps: contact stress every [`CONTACTS_PER_SAMPLE`] contact durations, particle fields at the
+/// multiple of that nearest to [`CONTACTS_PER_PARTICLE_SAMPLE`] durations.
+pub fn default_intervals(tc_steps: f64) -> (u64, u64) {
+    let every = (tc_steps * CONTACTS_PER_SAMPLE).round().max(1.0) as u64;
+    let target = CONTACTS_PER_PARTICLE_SAMPLE * tc_steps;
+    (
+        every,
+        ((target / every as f64).round().max(1.0) as u64) * every,
+    )
 }
 
 impl Inrun {
@@ -112,7 +127,16 @@ impl Inrun {
             trace: Vec::new(),
             free: 0,
             free_volume: 0.0,
+            reference_dt: None,
         })
+    }
+
+    /// The same accumulator whose errors take no τ below the bumpy-shear benchmark's reference
+    /// ([`blocking::REFERENCE_TAU`], in time units; the run's time step is `dt`): one run of a
+    /// few of its slow fluctuations measures their τ too small.
+    pub fn with_reference_tau(mut self, dt: f64) -> Inrun {
+        self.reference_dt = Some(dt);
+        self
     }
 
     /// Adds the sample of the state `snap` (its step in the window, its forces evaluated) to
@@ -222,7 +246,11 @@ impl Inrun {
             return None;
         }
         let units: Vec<Unit> = kept.iter().map(|&b| self.bins[b].clone()).collect();
-        let errors = blocking::field_errors(&units, &self.grid);
+        let floor = match self.reference_dt {
+            Some(dt) => blocking::reference_floor(self.bin_steps as f64 * dt),
+            None => vec![0.0; COLUMNS.len()],
+        };
+        let errors = blocking::field_errors_with_floor(&units, &self.grid, &floor);
         let blocks = blocking::common_blocks(&errors);
         let all = blocking::merged(&units);
         let col = |name: &str| COLUMNS.iter().position(|c| *c == name).expect("column");
@@ -314,6 +342,17 @@ pub fn csv_path(dir: &Path, name: &str) -> PathBuf {
     dir.join(format!("{name}.profiles_inrun.csv"))
 }
 
+/// Path of the in-run profiles' error table ([`blocking::errors_csv`]) of the run `name` in `dir`.
+pub fn errors_csv_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.profiles_inrun_errors.csv"))
+}
+
+/// The in-run profiles' error table: per column, its τ (measured, reference, used), blocks and
+/// how its error was taken ([`blocking::errors_csv`]).
+pub fn errors_csv(r: &InrunResult) -> String {
+    blocking::errors_csv(&r.errors, r.units.len())
+}
+
 /// The in-run profiles as CSV: the columns of `NAME.profiles.csv`.
 pub fn csv(r: &InrunResult) -> String {
     Table::of(&r.profiles).csv()
@@ -365,10 +404,18 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
     out.push_str("per-field errors of the saves (tau in saves):\n");
     out.push_str(&blocking::describe(save_errors, saves.saves.len(), "saves"));
     out.push_str(&format!(
-        "per-field errors in-run (tau in bins of {} steps):\n",
-        r.bin_steps
+        "per-field errors in-run (tau in bins of {} steps{}):\n",
+        r.bin_steps,
+        if r.errors.floor.iter().any(|&f| f > 0.0) {
+            "; no tau below the benchmark's reference, docs/statistics.md"
+        } else {
+            ""
+        }
     ));
     out.push_str(&blocking::describe(&r.errors, p.saves.len(), "bins"));
+    if r.errors.floor.iter().any(|&f| f > 0.0) {
+        out.push_str(blocking::SLOW_MODE_NOTE);
+    }
     out.push_str("checks of the in-run profiles:\n");
     let report = checks::report(p, &checks::run(p, r.density));
     // The first line of the saves' report speaks of saves; the in-run one is above, and the

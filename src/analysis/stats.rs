@@ -135,6 +135,24 @@ pub fn block_standard_error(x: &[f64], blocks: usize) -> f64 {
     standard_error(&means)
 }
 
+/// Standard error of the mean of `x`, an equally spaced series with integrated autocorrelation
+/// time `tau` (in units of its spacing), from τ itself: √(2τσ²/n), with the series' variance σ²
+/// estimated as c₀·n/(n − 2τ) from c₀ = Σ(x − x̄)²/n, which is low by the variance of the mean
+/// itself, ≈ 2τσ²/n (Sokal, "Monte Carlo methods in statistical mechanics", 1997, §3). Unlike
+/// blocks it needs no block as long as several τ, so it stays honest for a series of a few τ
+/// when τ is known from elsewhere; its own relative scatter is about √(τ/n). 0 for fewer than
+/// two values; with n ≤ 4τ the correction is capped at a factor 2 (n − 2τ taken as n/2).
+pub fn tau_standard_error(x: &[f64], tau: f64) -> f64 {
+    let n = x.len() as f64;
+    if x.len() < 2 || tau.is_nan() {
+        return 0.0;
+    }
+    let mean = x.iter().sum::<f64>() / n;
+    let c0 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+    let tau = tau.max(0.5);
+    (2.0 * tau * c0 / (n - 2.0 * tau).max(0.5 * n)).sqrt()
+}
+
 /// Integrated autocorrelation time τ = 1/2 + Σ ρ(t) of an equally spaced series, summed up to
 /// the first window W ≥ 5τ (Sokal's automatic window), in units of the series' spacing; at
 /// least 1/2 (uncorrelated values), exactly 1/2 for a constant series, NaN for fewer than four
@@ -386,6 +404,72 @@ mod tests {
             .count();
         let fraction = covered as f64 / replicas as f64;
         assert!((0.91..=0.98).contains(&fraction), "{fraction}");
+    }
+
+    /// A series with a slow mode: the sum of a slow AR(1) series (a = 0.98, τ = 49.5) and a
+    /// fast one (a = 0.5, τ = 1.5) of equal variance, so τ = (49.5 + 1.5)/2 = 25.5.
+    fn slow_mode(n: usize, seed: &mut u64) -> Vec<f64> {
+        let slow = ar1(0.98, n, seed);
+        // equal variances: the fast series is scaled by √((1 − 0.5²)/(1 − 0.98²))
+        let scale = ((1.0 - 0.25) / (1.0 - 0.98f64.powi(2))).sqrt();
+        let fast = ar1(0.5, n, seed);
+        slow.iter().zip(&fast).map(|(s, f)| s + scale * f).collect()
+    }
+
+    #[test]
+    fn errors_from_a_known_tau_cover_a_slow_mode_that_ten_blocks_miss() {
+        // 400 replicas of 500 values (about 20 τ): ten blocks of 50 ≈ 2τ values, or the series'
+        // own τ measured on 500 values, miss much of the slow mode's variance; the error from
+        // the true τ covers the true mean 0 as an error with n/τ − 1 degrees of freedom does.
+        let (replicas, n, tau) = (400, 500, 25.5);
+        let mut seed = 99;
+        let (mut blocks10, mut own, mut known) = (0, 0, 0);
+        for _ in 0..replicas {
+            let x = slow_mode(n, &mut seed);
+            let mean = x.iter().sum::<f64>() / n as f64;
+            let inside = |se: f64| usize::from(mean.abs() <= 2.0 * se);
+            blocks10 += inside(block_standard_error(&x, 10));
+            own += inside(tau_standard_error(&x, integrated_autocorrelation(&x)));
+            known += inside(tau_standard_error(&x, tau));
+        }
+        let frac = |k: usize| k as f64 / replicas as f64;
+        // P(|t| ≤ 2) with n/τ − 1 = 18.6 degrees of freedom: 0.939 (t tables: t(0.97, 18) = 2.10)
+        let expected = 0.939;
+        let binomial = (expected * (1.0 - expected) / replicas as f64).sqrt();
+        assert!(
+            (frac(known) - expected).abs() < 3.5 * binomial,
+            "known tau: {} vs {expected}",
+            frac(known)
+        );
+        assert!(frac(blocks10) < 0.88, "ten blocks: {}", frac(blocks10));
+        assert!(frac(own) < frac(known) - 0.03, "own tau: {}", frac(own));
+    }
+
+    #[test]
+    fn the_error_from_tau_is_the_known_one_for_independent_and_correlated_values() {
+        // independent values: τ = ½ gives the ordinary standard error
+        let x = [1.0, 2.0, 3.0, 4.0];
+        assert!((tau_standard_error(&x, 0.5) - standard_error(&x)).abs() < 1e-15);
+        assert_eq!(tau_standard_error(&[5.0], 3.0), 0.0);
+        // AR(1), a = 0.8 (τ = 4.5): √(2τ·variance/n) within 5 % over 400000 values
+        let (a, n) = (0.8, 400_000);
+        let x = ar1(a, n, &mut 2024);
+        let exact = (2.0 * 4.5 * (1.0 / 12.0) / (1.0 - a * a) / n as f64).sqrt();
+        let se = tau_standard_error(&x, 4.5);
+        assert!((se / exact - 1.0).abs() < 0.05, "{se} vs {exact}");
+        // n = 10τ: c₀ is low by 2τ/n = 20 % on average, which the error restores: over 2000
+        // replicas the mean of se² is the exact 2τσ²/n within 5 %
+        let (tau, n) = (4.5, 45);
+        let mut seed = 5;
+        let mean_var = (0..2000)
+            .map(|_| tau_standard_error(&ar1(a, n, &mut seed), tau).powi(2))
+            .sum::<f64>()
+            / 2000.0;
+        let exact = 2.0 * tau * (1.0 / 12.0) / (1.0 - a * a) / n as f64;
+        assert!(
+            (mean_var / exact - 1.0).abs() < 0.1,
+            "{mean_var} vs {exact}"
+        );
     }
 
     #[test]

@@ -222,9 +222,12 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         if let Some(r) = inrun.as_ref().and_then(inrun::Inrun::result) {
             let path = inrun::csv_path(&opts.out_dir, &case.name);
             atomic::write(&path, inrun::csv(&r).as_bytes())?;
+            let errors = inrun::errors_csv_path(&opts.out_dir, &case.name);
+            atomic::write(&errors, inrun::errors_csv(&r).as_bytes())?;
             println!("in-run profiles: {}", path.display());
             let units: Vec<Unit> = saved.per_save.iter().cloned().map(Unit::of_save).collect();
-            let save_errors = blocking::field_errors(&units, &saved.grid);
+            let floor = blocking::reference_floor(opts.save_every as f64 * case.dt());
+            let save_errors = blocking::field_errors_with_floor(&units, &saved.grid, &floor);
             report.push_str(&inrun::report(&r, &saved, &save_errors));
             let checks = opts.out_dir.join(format!("{}.checks.txt", case.name));
             atomic::write(&checks, report.as_bytes())?;
@@ -279,11 +282,10 @@ fn in_run(
         from: from.max(start),
         to: opts.end_step,
     };
-    Ok(Some(Inrun::new(
-        &CgOptions::for_case(case),
-        &engine.state().domain,
-        sampling,
-    )?))
+    Ok(Some(
+        Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
+            .with_reference_tau(case.dt()),
+    ))
 }
 
 /// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has

@@ -20,9 +20,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use serde::Deserialize;
 
+use crate::analysis::cg::blocking;
 use crate::analysis::cg::table::Table;
 use crate::analysis::cg::{self, CgOptions};
 use crate::analysis::ensemble::{self as merge, Coverage};
+use crate::analysis::inrun::{self, Inrun, Sampling};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::io::{atomic, hash};
@@ -123,6 +125,10 @@ pub struct Record {
     /// Saves coarse-grained into the replica's profiles and the blocks of their errors.
     pub saves: usize,
     pub blocks: usize,
+    /// Per benchmark profile ([`cg::FIELDS`]): the degrees of freedom of its in-run standard
+    /// error ([`blocking::degrees_of_freedom`]); empty when the replica has no in-run profiles.
+    #[serde(default)]
+    pub inrun_dof: Vec<f64>,
 }
 
 /// A u64 written as quoted decimal text.
@@ -135,7 +141,7 @@ fn u64_text<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
 impl Record {
     fn toml(&self) -> String {
         format!(
-            "replica = {}\nseed = \"{}\"\nbase_seed = \"{}\"\nperturbation = {:e}\nstart_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}\nblocks = {}\n",
+            "replica = {}\nseed = \"{}\"\nbase_seed = \"{}\"\nperturbation = {:e}\nstart_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}\nblocks = {}\ninrun_dof = {:?}\n",
             self.replica,
             self.seed,
             self.base_seed,
@@ -144,7 +150,8 @@ impl Record {
             self.hash,
             self.step,
             self.saves,
-            self.blocks
+            self.blocks,
+            self.inrun_dof
         )
     }
 
@@ -198,6 +205,7 @@ impl Plan {
             },
         );
         let start_hash = hash::state_hash(&engine.snapshot());
+        let start_step = engine.state().step;
         let dir = replica_dir(&self.out, k);
         run::claim_output_folder(&dir, &case.name, true, "--replica")?;
         let opts = RunOptions {
@@ -212,9 +220,30 @@ impl Plan {
             vtk: false,
             stop: None,
         };
-        let s = run::run(engine.as_mut(), &opts, false)?;
+        let mut inrun = in_run(&case, engine.as_ref(), &opts, start_step)?;
+        let s = run::run_observed(
+            engine.as_mut(),
+            &opts,
+            false,
+            inrun.as_mut().map(|i| i as &mut dyn run::Observer),
+        )?;
         run::write_summary(&dir, &case.name, &s, 1)?;
         let (profiles, _) = cg::write_all(&dir.join(&case.name), &CgOptions::for_case(&case))?;
+        let mut inrun_dof = Vec::new();
+        if let Some(r) = inrun.as_ref().and_then(Inrun::result) {
+            atomic::write(
+                &inrun::csv_path(&dir, &case.name),
+                inrun::csv(&r).as_bytes(),
+            )?;
+            atomic::write(
+                &inrun::errors_csv_path(&dir, &case.name),
+                inrun::errors_csv(&r).as_bytes(),
+            )?;
+            inrun_dof = cg::FIELDS
+                .iter()
+                .map(|&(_, c)| blocking::degrees_of_freedom(&r.errors, c, r.units.len()))
+                .collect();
+        }
         let record = Record {
             replica: k,
             seed,
@@ -225,6 +254,7 @@ impl Plan {
             step: s.step,
             saves: profiles.saves.len(),
             blocks: profiles.blocks,
+            inrun_dof,
         };
         atomic::write(
             &record_path(&self.out, &case.name, k),
@@ -316,17 +346,90 @@ impl Plan {
         let blocks = records.iter().map(|r| r.blocks).min().unwrap_or(0);
         let table = merge::merge(&tables)?;
         let coverage = merge::coverage(&tables, &table, blocks)?;
+        let inrun = merge_inrun(self, name, &records)?;
         let merged = Merged {
             engine: engine.to_string(),
             records,
             coverage,
             blocks,
             table,
+            inrun,
         };
         atomic::write(&merged_path(&self.out, name), merged.table.csv().as_bytes())?;
+        if let Some((t, _)) = &merged.inrun {
+            atomic::write(&merged_inrun_path(&self.out, name), t.csv().as_bytes())?;
+        }
         atomic::write(&summary_path(&self.out, name), merged.toml(self).as_bytes())?;
         Ok(merged)
     }
+}
+
+/// The in-run averaging of a replica of a bumpy-shear `case` (none for other scenes), as
+/// `verdem run` samples by default: over the steps of the second half of the saves the replica
+/// writes from `start` (its first step), with the benchmark's reference τ as the errors' floor.
+fn in_run(
+    case: &Case,
+    engine: &dyn crate::step::Engine,
+    opts: &RunOptions,
+    start: u64,
+) -> anyhow::Result<Option<Inrun>> {
+    if !matches!(case.scene, crate::case::Scene::BumpyShear { .. }) {
+        return Ok(None);
+    }
+    let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
+    let (every, particle_every) = inrun::default_intervals(tc_steps);
+    let first = start.div_ceil(opts.save_every);
+    let saves = (opts.end_step / opts.save_every + 1).saturating_sub(first);
+    let from = (first + saves.div_ceil(2).min(saves.saturating_sub(1))) * opts.save_every;
+    let sampling = Sampling {
+        every,
+        particle_every,
+        from: from.max(start),
+        to: opts.end_step,
+    };
+    Ok(Some(
+        Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
+            .with_reference_tau(case.dt()),
+    ))
+}
+
+/// The ensemble of the replicas' in-run profiles and the coverage of their own errors, the
+/// expected coverage from each profile's fewest degrees of freedom over the replicas; `None`
+/// when a replica has none.
+fn merge_inrun(
+    plan: &Plan,
+    name: &str,
+    records: &[Record],
+) -> anyhow::Result<Option<(Table, Vec<Coverage>)>> {
+    let paths: Vec<PathBuf> = (0..plan.replicas)
+        .map(|k| inrun::csv_path(&replica_dir(&plan.out, k), name))
+        .collect();
+    if records
+        .iter()
+        .any(|r| r.inrun_dof.len() != cg::FIELDS.len())
+        || paths.iter().any(|p| !p.exists())
+    {
+        return Ok(None);
+    }
+    let tables = paths
+        .iter()
+        .map(|p| Table::read(p))
+        .collect::<Result<Vec<Table>, _>>()?;
+    let table = merge::merge(&tables)?;
+    let mut coverage = merge::coverage(&tables, &table, 2)?;
+    for (f, c) in coverage.iter_mut().enumerate() {
+        let dof = records
+            .iter()
+            .map(|r| r.inrun_dof[f])
+            .fold(f64::INFINITY, f64::min);
+        c.expected = merge::expected_coverage_dof(tables.len(), dof);
+    }
+    Ok(Some((table, coverage)))
+}
+
+/// Path of the merged in-run profiles, `DIR/NAME.profiles_inrun_ensemble.csv`.
+pub fn merged_inrun_path(out: &Path, name: &str) -> PathBuf {
+    out.join(format!("{name}.profiles_inrun_ensemble.csv"))
 }
 
 /// The replica numbers K of the folders `replica_K` in `out`, increasing.
@@ -361,6 +464,9 @@ pub struct Merged {
     pub coverage: Vec<Coverage>,
     /// The fewest blocks any replica's errors came from.
     pub blocks: usize,
+    /// The ensemble of the replicas' in-run profiles and the coverage of their own (per-field)
+    /// errors, when every replica has in-run profiles.
+    pub inrun: Option<(Table, Vec<Coverage>)>,
 }
 
 impl Merged {
@@ -380,10 +486,15 @@ impl Merged {
                 r.replica, r.seed, r.start_hash, r.hash, r.step, r.saves
             );
         }
-        for c in &self.coverage {
+        let inrun = self.inrun.iter().flat_map(|(_, c)| c);
+        for (table, c) in std::iter::repeat_n("field", self.coverage.len())
+            .zip(&self.coverage)
+            .chain(std::iter::repeat("field_inrun").zip(inrun))
+        {
+            let (lo, hi) = merge::wilson_interval(c.inside, c.pairs);
             let _ = writeln!(
                 s,
-                "\n[[field]]\nname = {:?}\ncore_mean = {:e}\ncore_se = {:e}\ncoverage = {}\npairs = {}\nexpected_coverage = {}\nspread_over_block_error = {}",
+                "\n[[{table}]]\nname = {:?}\ncore_mean = {:e}\ncore_se = {:e}\ncoverage = {}\ncoverage_interval = [{lo}, {hi}]\npairs = {}\nexpected_coverage = {}\nspread_over_block_error = {}",
                 c.field,
                 c.core_mean,
                 c.core_se,
@@ -414,33 +525,49 @@ impl Merged {
                  the coverage test needs more saves per replica (--every)"
             );
         }
-        let _ = writeln!(
-            s,
-            "{:<9} {:>13} {:>11} {:>9} {:>9} {:>14}",
-            "field", "core mean", "ensemble SE", "coverage", "expected", "spread/blockSE"
-        );
-        for c in &self.coverage {
+        s.push_str(&coverage_table(&self.coverage));
+        if let Some((_, c)) = &self.inrun {
             let _ = writeln!(
                 s,
-                "{:<9} {:>13.5e} {:>11.2e} {:>8.1}% {:>8.1}% {:>14.2}",
-                c.field,
-                c.core_mean,
-                c.core_se,
-                100.0 * c.fraction(),
-                100.0 * c.expected,
-                c.spread_ratio
+                "in-run profiles, each field's own errors (no tau below the benchmark's reference):"
             );
+            s.push_str(&coverage_table(c));
         }
         let _ = writeln!(
             s,
             "coverage: the fraction of (replica, core slice) pairs whose value lies within ±2 of \
-             the replica's own block standard error of the ensemble mean; expected: that \
-             fraction when the block errors are honest (P(|t| ≤ 2/√(1 − 1/R)), t with blocks − 1 \
-             degrees of freedom); spread/blockSE: the replicas' scatter over their own error \
-             bars (1 when honest)"
+             the replica's own standard error of the ensemble mean, with its 95 % binomial \
+             (Wilson) interval; expected: that fraction when the errors are honest (P(|t| ≤ \
+             2/√(1 − 1/R)), t with the errors' degrees of freedom: blocks − 1); spread/SE: the \
+             replicas' scatter over their own error bars (1 when honest)"
         );
         s
     }
+}
+
+/// The coverage lines of one set of profiles: per benchmark profile, the core mean with its
+/// ensemble error, the coverage with its interval, the expected coverage and the spread ratio.
+fn coverage_table(coverage: &[Coverage]) -> String {
+    let mut s = format!(
+        "{:<9} {:>13} {:>11} {:>9} {:>15} {:>9} {:>9}\n",
+        "field", "core mean", "ensemble SE", "coverage", "95% interval", "expected", "spread/SE"
+    );
+    for c in coverage {
+        let (lo, hi) = merge::wilson_interval(c.inside, c.pairs);
+        let _ = writeln!(
+            s,
+            "{:<9} {:>13.5e} {:>11.2e} {:>8.1}% {:>6.1}-{:>5.1}% {:>8.1}% {:>9.2}",
+            c.field,
+            c.core_mean,
+            c.core_se,
+            100.0 * c.fraction(),
+            100.0 * lo,
+            100.0 * hi,
+            100.0 * c.expected,
+            c.spread_ratio
+        );
+    }
+    s
 }
 
 /// How the process running one replica ended, on either engine.

@@ -5,7 +5,10 @@
 
 use super::fields::{derive, Grid, Raw};
 use super::{columns, core_range, COLUMNS};
-use crate::analysis::stats::{block, block_length_for, integrated_autocorrelation, median};
+use crate::analysis::stats::{
+    block, block_length_for, blocks_for, integrated_autocorrelation, median, standard_error,
+    tau_standard_error, MIN_BLOCKS,
+};
 
 /// One unit of the series a profile is averaged from: a save, or a bin of in-run samples. It
 /// holds the sums of its samples' raw fields and how many samples of the particles (volume
@@ -81,15 +84,63 @@ pub fn block_columns(units: &[Unit], blocks: usize) -> Vec<Vec<Vec<f64>>> {
         .collect()
 }
 
+/// How a column's standard error was taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// From blocks of at least [`block_length_for`] its τ, [`MIN_BLOCKS`] of them or more.
+    Blocks,
+    /// From its τ ([`tau_standard_error`]): the series is too short for such blocks, but τ is
+    /// at least the reference's ([`REFERENCE_TAU`]) and the series is [`MIN_BLOCKS`] τ long or
+    /// more (its error's degrees of freedom, [`degrees_of_freedom`], at least those of
+    /// [`MIN_BLOCKS`] blocks).
+    Tau,
+    /// Too short: no reference τ and too few units for blocks (τ measured on a series shorter
+    /// than its slow fluctuations comes out too small), or shorter than [`MIN_BLOCKS`] τ.
+    /// The error is taken from τ all the same and is not to be trusted.
+    TooShort,
+}
+
 /// Per column of [`COLUMNS`]: the integrated autocorrelation time (in units) of its series,
-/// the blocks its standard error comes from and whether they are [`block_length_for`] long.
+/// the blocks its standard error comes from and how the error was taken.
 #[derive(Clone, Debug)]
 pub struct FieldErrors {
+    /// τ the error was taken with: the larger of `measured` and `floor`.
     pub tau: Vec<f64>,
+    /// τ measured on this series ([`field_taus`]).
+    pub measured: Vec<f64>,
+    /// The reference τ in units (0 where there is none).
+    pub floor: Vec<f64>,
+    /// Blocks of [`block_length_for`] `tau` (or [`MIN_BLOCKS`] shorter ones when too few), as
+    /// the checks' core means take them.
     pub blocks: Vec<usize>,
-    pub long_enough: Vec<bool>,
+    pub method: Vec<Method>,
     /// Standard error of each column, per grid point.
     pub se: Vec<Vec<f64>>,
+}
+
+/// Integrated autocorrelation time, in time units, of each column of [`COLUMNS`] at one slice of
+/// the steady bumpy-shear benchmark (`cases/shear_flow_steady.toml`): the per-slice τ an
+/// ensemble of independent replicas gives, τ = (n/2)·V/(c₀ + V) from the variance V of the
+/// replicas' window means and the mean variance c₀ of a replica's saves about its own mean,
+/// median over the core slices (docs/statistics.md, "Reference autocorrelation times"). Runs
+/// of the benchmark's flow take no τ below these: one run of a few τ measures its own τ too
+/// small. 0 for the contact stress, which decorrelates within a contact's duration.
+pub const REFERENCE_TAU: [f64; 26] = [
+    4.7, 4.7, 3.3, 2.1, 0.83, 1.19, 1.72, 0.96, 0.80, 0.96, 1.90, 0.69, 0.80, 0.69, 1.03, 0.0, 0.0,
+    0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+];
+
+/// What no error of one run of the benchmark's flow (nor of an ensemble of perturbed copies of
+/// one state) includes: the bed's mean x-velocity drifts on times longer than the 57.5 time
+/// units the reference ensemble ran, so every replica keeps its start's value
+/// (docs/statistics.md).
+pub const SLOW_MODE_NOTE: &str = "  note: the bed's mean x-velocity drifts on times longer than \
+     57 time units; no error here includes that drift (a common offset of vx, and of the fields \
+     that follow it), docs/statistics.md\n";
+
+/// [`REFERENCE_TAU`] in units of `unit_time` (the time a unit of the series spans).
+pub fn reference_floor(unit_time: f64) -> Vec<f64> {
+    REFERENCE_TAU.iter().map(|t| t / unit_time).collect()
 }
 
 /// The integrated autocorrelation time of each column: the larger of that of its core mean
@@ -127,31 +178,73 @@ pub fn field_taus(units: &[Unit], grid: &Grid) -> Vec<f64> {
         .collect()
 }
 
-/// Standard errors of every column from blocks of at least [`block_length_for`] its own τ
-/// ([`field_taus`]); where the units are too few for [`crate::analysis::stats::MIN_BLOCKS`]
-/// such blocks, from that many shorter ones, flagged.
+/// The degrees of freedom of column `c`'s variance estimate in `errors` over `units` units:
+/// blocks − 1 from blocks; from τ, n/τ − 1 (the sample variance of n values with an exponential
+/// autocorrelation of integrated time τ scatters as that of n/τ independent ones; Priestley,
+/// *Spectral Analysis and Time Series*, 1981, §5.3), at least 1.
+pub fn degrees_of_freedom(errors: &FieldErrors, c: usize, units: usize) -> f64 {
+    match errors.method[c] {
+        Method::Blocks => errors.blocks[c] as f64 - 1.0,
+        _ => (units as f64 / errors.tau[c] - 1.0).max(1.0),
+    }
+}
+
+/// Standard errors of every column without a reference τ: [`field_errors_with_floor`] with
+/// no floor.
 pub fn field_errors(units: &[Unit], grid: &Grid) -> FieldErrors {
-    let tau = field_taus(units, grid);
-    let chosen: Vec<(usize, bool)> = tau
+    field_errors_with_floor(units, grid, &[0.0; COLUMNS.len()])
+}
+
+/// Standard errors of every column, per grid point, with τ the larger of its own
+/// ([`field_taus`]) and `floor` (units, per column): from blocks of at least
+/// [`block_length_for`] τ when the units hold [`MIN_BLOCKS`] of them ([`Method::Blocks`]), else
+/// from τ ([`tau_standard_error`], [`Method::Tau`] or [`Method::TooShort`]).
+pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floor: &[f64]) -> FieldErrors {
+    let measured = field_taus(units, grid);
+    let n = units.len();
+    let tau: Vec<f64> = measured
         .iter()
-        .map(|&t| crate::analysis::stats::blocks_for(units.len(), t))
+        .zip(floor)
+        .map(|(&m, &f)| if m.is_nan() && f > 0.0 { f } else { m.max(f) })
+        .collect();
+    let chosen: Vec<(usize, Method)> = tau
+        .iter()
+        .zip(floor)
+        .map(|(&t, &f)| match blocks_for(n, t) {
+            (b, true) => (b, Method::Blocks),
+            (b, false) if f > 0.0 && n as f64 >= MIN_BLOCKS as f64 * t => (b, Method::Tau),
+            (b, false) => (b, Method::TooShort),
+        })
+        .collect();
+    let per_unit: Vec<Vec<Vec<f64>>> = units
+        .iter()
+        .map(|u| derive(&u.mean()).iter().map(columns).collect())
         .collect();
     let mut cache: Vec<(usize, Vec<Vec<Vec<f64>>>)> = Vec::new();
     let mut se = vec![vec![0.0; COLUMNS.len()]; grid.n];
-    for (c, &(blocks, _)) in chosen.iter().enumerate() {
+    for (c, &(blocks, method)) in chosen.iter().enumerate() {
+        if method != Method::Blocks {
+            for (k, row) in se.iter_mut().enumerate() {
+                let vals: Vec<f64> = per_unit.iter().map(|u| u[k][c]).collect();
+                row[c] = tau_standard_error(&vals, tau[c]);
+            }
+            continue;
+        }
         if !cache.iter().any(|(b, _)| *b == blocks) {
             cache.push((blocks, block_columns(units, blocks)));
         }
         let (_, cols) = cache.iter().find(|(b, _)| *b == blocks).expect("cached");
         for (k, row) in se.iter_mut().enumerate() {
             let vals: Vec<f64> = cols.iter().map(|b| b[k][c]).collect();
-            row[c] = crate::analysis::stats::standard_error(&vals);
+            row[c] = standard_error(&vals);
         }
     }
     FieldErrors {
         tau,
+        measured,
+        floor: floor.to_vec(),
         blocks: chosen.iter().map(|c| c.0).collect(),
-        long_enough: chosen.iter().map(|c| c.1).collect(),
+        method: chosen.iter().map(|c| c.1).collect(),
         se,
     }
 }
@@ -171,15 +264,33 @@ pub fn shown(x: f64) -> String {
     }
 }
 
-/// A line per column of [`COLUMNS`]: its τ in `unit`s, its blocks (of `units` in all) and the
-/// block length it needs.
+/// A line per column of [`COLUMNS`]: its τ in `unit`s (and the reference's, when it sets
+/// τ), its blocks (of `units` in all) and the block length it needs, and how its error was
+/// taken.
 pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
     let mut s = String::new();
     for (c, name) in COLUMNS.iter().enumerate() {
         let len = block_length_for(errors.tau[c]);
+        let floored = errors.floor[c] > 0.0 && errors.tau[c] == errors.floor[c];
+        let tau = if floored {
+            format!(
+                "{} {unit} (reference; measured {})",
+                shown(errors.tau[c]),
+                shown(errors.measured[c])
+            )
+        } else {
+            format!("{} {unit}", shown(errors.tau[c]))
+        };
+        let how = match errors.method[c] {
+            Method::Blocks => String::new(),
+            Method::Tau => format!(
+                ": error from tau ({:.1} degrees of freedom)",
+                degrees_of_freedom(errors, c, units)
+            ),
+            Method::TooShort => ": TOO SHORT, error not to be trusted".into(),
+        };
         s.push_str(&format!(
-            "  {name:9} tau {:>8} {unit}, {:>5} blocks of {:>7.1} (needs >= {}){}\n",
-            shown(errors.tau[c]),
+            "  {name:9} tau {tau}, {} blocks of {:.1} (needs >= {}){how}\n",
             errors.blocks[c],
             units as f64 / errors.blocks[c] as f64,
             if len.is_finite() {
@@ -187,10 +298,38 @@ pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
             } else {
                 "?".into()
             },
-            if errors.long_enough[c] {
-                ""
-            } else {
-                ": TOO SHORT, error too small"
+        ));
+    }
+    s
+}
+
+/// The per-column error table written beside in-run profiles (`NAME.profiles_inrun_errors.csv`):
+/// per column of [`COLUMNS`], τ measured, the reference τ and the τ used (all in units of the
+/// series), the blocks, the degrees of freedom of the error ([`degrees_of_freedom`]) and how it
+/// was taken (`blocks`, `tau`, or `TOO SHORT`).
+pub fn errors_csv(errors: &FieldErrors, units: usize) -> String {
+    let mut s = String::from(
+        "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,method\n",
+    );
+    let num = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.4}")
+        } else {
+            String::new()
+        }
+    };
+    for (c, name) in COLUMNS.iter().enumerate() {
+        s.push_str(&format!(
+            "{name},{},{},{},{},{},{}\n",
+            num(errors.measured[c]),
+            num(errors.floor[c]),
+            num(errors.tau[c]),
+            errors.blocks[c],
+            num(degrees_of_freedom(errors, c, units)),
+            match errors.method[c] {
+                Method::Blocks => "blocks",
+                Method::Tau => "tau",
+                Method::TooShort => "TOO SHORT",
             }
         ));
     }
@@ -214,6 +353,60 @@ mod tests {
                 x
             })
             .collect()
+    }
+
+    #[test]
+    fn a_series_too_short_for_its_blocks_takes_the_reference_tau_or_says_too_short() {
+        // 400 saves whose volume fraction follows a slow AR(1) series (a = 0.98, τ = 49.5):
+        // blocks of 5(2τ − 1) = 490 saves are longer than the series, and τ measured on it is
+        // too small
+        let grid = Grid {
+            z0: 0.0,
+            z1: 10.0,
+            n: 10,
+        };
+        let n = 400;
+        let slow = ar1(0.98, n, 3);
+        let units: Vec<Unit> = (0..n)
+            .map(|t| {
+                let mut raw = Raw::zeros(grid.n);
+                for k in 0..grid.n {
+                    raw.nu[k] = 0.5 + slow[t];
+                    raw.rho[k] = 1.0;
+                }
+                Unit::of_save(raw)
+            })
+            .collect();
+        let nu = 0;
+        let own = field_errors(&units, &grid);
+        assert_eq!(own.method[nu], Method::TooShort, "tau {}", own.tau[nu]);
+        assert!(describe(&own, n, "saves")
+            .lines()
+            .next()
+            .unwrap()
+            .contains("TOO SHORT"));
+        // with a reference τ of 49.5 saves (400 ≥ 5τ): every slice's error is the error from
+        // that τ of its own series (stats::tau_standard_error, tested there)
+        let mut floor = vec![0.0; COLUMNS.len()];
+        floor[nu] = 49.5;
+        let e = field_errors_with_floor(&units, &grid, &floor);
+        assert_eq!(e.method[nu], Method::Tau);
+        assert_eq!(e.tau[nu], 49.5f64.max(own.tau[nu]));
+        let series: Vec<f64> = slow.iter().map(|s| 0.5 + s).collect();
+        let expected = tau_standard_error(&series, e.tau[nu]);
+        for k in 0..grid.n {
+            assert!(
+                (e.se[k][nu] / expected - 1.0).abs() < 1e-9,
+                "{}",
+                e.se[k][nu]
+            );
+        }
+        assert!((degrees_of_freedom(&e, nu, n) - (n as f64 / e.tau[nu] - 1.0)).abs() < 1e-12);
+        let csv = errors_csv(&e, n);
+        let row = csv.lines().find(|l| l.starts_with("nu,")).unwrap();
+        assert!(row.ends_with(",tau") && row.contains(",49.5000,"), "{row}");
+        // a column without a reference τ keeps its own, and a constant one its blocks of one
+        assert_eq!(e.method[COLUMNS.len() - 1], Method::Blocks);
     }
 
     #[test]
@@ -247,7 +440,7 @@ mod tests {
         assert_eq!(e.tau[con], 0.5, "a constant column");
         // blocks of at least 5(2τ − 1) ≈ 40 saves for ν, of one save for vx
         assert!(
-            e.long_enough[nu] && n / e.blocks[nu] >= 35,
+            e.method[nu] == Method::Blocks && n / e.blocks[nu] >= 35,
             "{}",
             e.blocks[nu]
         );
