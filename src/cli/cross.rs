@@ -38,11 +38,11 @@ pub struct Args {
         value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
     )]
     convention: Option<Tangential>,
-    /// Average in-run too, in the peer (from dumps every K and KP steps), in verdem with the
-    /// peer's convention and in verdem with the case's own convention, over the same steps;
-    /// writes PEER.profiles_inrun.csv, verdem.profiles_inrun.csv, verdem_own.profiles_inrun.csv
-    /// and compares their core means with 95 % intervals (docs/peers: not LAMMPS-family
-    /// peers).
+    /// Average in-run too (LAMMPS and LIGGGHTS), in the peer (from dumps every K and KP
+    /// steps), in verdem with the peer's convention and in verdem with the case's own
+    /// convention, over the same steps; writes PEER.profiles_inrun.csv,
+    /// verdem.profiles_inrun.csv, verdem_own.profiles_inrun.csv and inrun.md, their core means
+    /// compared with 95 % intervals (docs/peers-inrun.md).
     #[arg(long)]
     inrun: bool,
     /// With --inrun: contact stress and wall forces every K steps (default: 8 contact
