@@ -10,11 +10,24 @@
 # peer recorded in golden/peers/) and one overlay of the codes (profiles.png). About 70 minutes
 # of the machine for 1e7 steps of LAMMPS and LIGGGHTS; Yade, at 300-900 steps/s, takes hours.
 #   ci/record_peers.sh [PEER ...]
-#   STEPS=N   steps of each run (default 10000000)
+#   ci/record_peers.sh --inrun [PEER ...]
+#   STEPS=N   steps of each run (default 10000000; with --inrun 1000000)
 #   STATE=F   the start state (default: the full run's final state)
+# With --inrun only the in-run comparison is recorded, and no other file of golden/peers is
+# touched: the LAMMPS-family peers named (default lammps and liggghts), 1 rank each, all at once,
+# average in-run (`verdem cross --inrun`: contact stress and wall forces every 8 contact
+# durations, particle fields every 24, from their dumps), as do verdem in each peer's convention
+# and verdem in MercuryDPM's, over the same steps. Kept: each run's in-run profiles
+# (PEER.profiles_inrun.csv, verdem_as_PEER.profiles_inrun.csv, verdem.profiles_inrun.csv) and
+# compare_inrun.md (the core means with 95 % intervals, with provenance).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-STEPS=${STEPS:-10000000}
+INRUN=0
+if [ "${1:-}" = "--inrun" ]; then
+  INRUN=1
+  shift
+fi
+if [ "$INRUN" = 1 ]; then STEPS=${STEPS:-1000000}; else STEPS=${STEPS:-10000000}; fi
 STATE=${STATE:-golden/full_run/shear_flow.final.data}
 OUT=out/record_peers
 G=golden/peers
@@ -25,6 +38,51 @@ mkdir -p "$G" "$OUT"
 BIN="$OUT/verdem"
 cp target/release/verdem "$BIN"
 START_SHA=$(sha256sum "$STATE" | cut -d' ' -f1)
+if [ "$INRUN" = 1 ]; then
+  [ $# -gt 0 ] || set -- lammps liggghts
+  IN="$OUT/inrun"
+  for peer in "$@"; do
+    "$BIN" cross "$peer" cases/shear_flow.toml --from "$STATE" --steps "$STEPS" --every 50000 \
+      --np 1 --out "$IN" --inrun --force > "$OUT/$peer.inrun.log" 2>&1 &
+  done
+  wait
+  own=
+  for peer in "$@"; do
+    bin=$("$BIN" peers "$peer" | cut -f2)
+    dir="$IN/$bin"
+    cp "$dir/$bin.profiles_inrun.csv" "$G/$peer.profiles_inrun.csv"
+    cp "$dir/verdem.profiles_inrun.csv" "$G/verdem_as_$peer.profiles_inrun.csv"
+    # verdem's own run is the same run in every cross-run (one thread, one state)
+    if [ -z "$own" ]; then
+      own="$dir/verdem_own.profiles_inrun.csv"
+    else
+      cmp "$own" "$dir/verdem_own.profiles_inrun.csv"
+    fi
+  done
+  cp "$own" "$G/verdem.profiles_inrun.csv"
+  {
+    echo "# The cross-code comparison with in-run averaging in every code (written by ci/record_peers.sh --inrun)"
+    echo
+    echo "Recorded $(date -u +%Y-%m-%dT%H:%M:%SZ) at commit $COMMIT, from $STATE (SHA-256 $START_SHA),"
+    echo "$STEPS steps of cases/shear_flow.toml, 1 MPI rank or thread per run. Commands:"
+    echo
+    for peer in "$@"; do
+      echo "- \`verdem cross $peer cases/shear_flow.toml --from $STATE --steps $STEPS --every 50000 --np 1 --inrun\` ($("$BIN" peers "$peer" | cut -f5))"
+    done
+    echo
+    echo "Each runs the peer (\`$("$BIN" peers "$1" | cut -f4)\`, its dumps read by verdem's"
+    echo "in-run accumulator), verdem in the peer's convention and verdem in the case's own (MercuryDPM's)."
+    for peer in "$@"; do
+      bin=$("$BIN" peers "$peer" | cut -f2)
+      echo
+      echo "## $peer"
+      echo
+      cat "$IN/$bin/inrun.md"
+    done
+  } > "$G/compare_inrun.md"
+  echo "recorded in $G/compare_inrun.md"
+  exit 0
+fi
 # each peer's line of `verdem peers` (an unknown name stops here, with the known ones):
 # name, binary, tangential convention, command of a 1-rank run, installed version
 if [ $# -gt 0 ]; then LIST=$("$BIN" peers "$(IFS=,; echo "$*")"); else LIST=$("$BIN" peers); fi

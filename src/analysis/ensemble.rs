@@ -171,7 +171,7 @@ pub fn wilson_interval(inside: usize, trials: usize) -> (f64, f64) {
 /// P(|T| ≤ x) for Student's t with `dof` degrees of freedom: twice the integral from 0 to x of
 /// its density Γ((ν+1)/2) / (√(νπ) Γ(ν/2)) · (1 + t²/ν)^(−(ν+1)/2) (Student 1908), by Simpson's
 /// rule on 2000 intervals (error below 1e-9 for x ≤ 10).
-fn student_t_within(x: f64, dof: f64) -> f64 {
+pub fn student_t_within(x: f64, dof: f64) -> f64 {
     let norm = (libm::lgamma((dof + 1.0) / 2.0) - libm::lgamma(dof / 2.0)).exp()
         / (dof * std::f64::consts::PI).sqrt();
     let density = |t: f64| norm * (1.0 + t * t / dof).powf(-(dof + 1.0) / 2.0);

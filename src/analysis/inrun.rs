@@ -19,6 +19,7 @@ use crate::analysis::cg::{
 };
 use crate::analysis::stats::integrated_autocorrelation;
 use crate::analysis::{Limit, Verdict};
+use crate::case::Case;
 use crate::contact::PairInput;
 use crate::run::Observer;
 use crate::state::{Domain, Snapshot};
@@ -42,6 +43,20 @@ pub const CONTACTS_PER_SAMPLE: f64 = 8.0;
 /// Contact durations between two samples of the particle fields: they change on the time
 /// between a particle's collisions, many contact durations (docs/statistics.md).
 pub const CONTACTS_PER_PARTICLE_SAMPLE: f64 = 20.0;
+
+/// The sampling intervals of `case`, in steps: `every` and `particle_every` when given, else
+/// the contact stress every [`CONTACTS_PER_SAMPLE`] free–free contact durations and the
+/// particle fields at the multiple of `every` nearest to [`CONTACTS_PER_PARTICLE_SAMPLE`]
+/// durations (50 steps per duration when the case has none).
+pub fn intervals(case: &Case, every: Option<u64>, particle_every: Option<u64>) -> (u64, u64) {
+    let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
+    let every = every.unwrap_or_else(|| (tc_steps * CONTACTS_PER_SAMPLE).round().max(1.0) as u64);
+    let particle_every = particle_every.unwrap_or_else(|| {
+        let target = CONTACTS_PER_PARTICLE_SAMPLE * tc_steps;
+        ((target / every.max(1) as f64).round().max(1.0) as u64) * every
+    });
+    (every, particle_every)
+}
 
 /// When to sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,8 +156,8 @@ impl Inrun {
 
     /// Adds the sample of the state `snap` (its step in the window, its forces evaluated) to
     /// the bin of its step: the contact stress and wall forces, and the particle fields when
-    /// `particles`.
-    fn sample(&mut self, snap: &Snapshot, particles: bool) {
+    /// `particles`. Samples must come in the order of their steps, each in (`from`, `to`].
+    pub fn sample(&mut self, snap: &Snapshot, particles: bool) {
         let step = snap.step;
         let mut b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
         while b >= MAX_BINS {
@@ -360,7 +375,7 @@ pub fn csv(r: &InrunResult) -> String {
 
 /// The core mean of column `name` over `units` and its standard error from `blocks` blocks of
 /// them.
-fn core_mean(units: &[Unit], grid: &Grid, blocks: usize, name: &str) -> (f64, f64) {
+pub fn core_mean(units: &[Unit], grid: &Grid, blocks: usize, name: &str) -> (f64, f64) {
     let c = COLUMNS.iter().position(|x| *x == name).expect("column");
     let core = core_range(grid);
     let n = core.len() as f64;

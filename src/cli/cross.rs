@@ -38,6 +38,21 @@ pub struct Args {
         value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
     )]
     convention: Option<Tangential>,
+    /// Average in-run too (LAMMPS and LIGGGHTS), in the peer (from dumps every K and KP
+    /// steps), in verdem with the peer's convention and in verdem with the case's own
+    /// convention, over the same steps; writes PEER.profiles_inrun.csv,
+    /// verdem.profiles_inrun.csv, verdem_own.profiles_inrun.csv and inrun.md, their core means
+    /// compared with 95 % intervals (docs/peers-inrun.md).
+    #[arg(long)]
+    inrun: bool,
+    /// With --inrun: contact stress and wall forces every K steps (default: 8 contact
+    /// durations, as `verdem run`); K must divide --every.
+    #[arg(long, value_name = "K", requires = "inrun", value_parser = count::<u64>)]
+    inrun_every: Option<u64>,
+    /// With --inrun: particle fields every KP steps, a multiple of K (default: the multiple
+    /// nearest to 20 contact durations).
+    #[arg(long, value_name = "KP", requires = "inrun", value_parser = count::<u64>)]
+    inrun_particle_every: Option<u64>,
     /// Replace the saves of an earlier cross-run in OUT/PEER (without it, such a folder is
     /// refused and nothing is written).
     #[arg(long)]
@@ -51,8 +66,11 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         run::claim_output_folder(&out.join(series), &case.name, a.force, "--force")?;
     }
     let convention = a.convention.unwrap_or(a.peer.convention());
-    let report = cross::cross(
-        a.peer, &case, convention, &a.from, a.steps, a.every, a.np, &out,
+    let inrun = a
+        .inrun
+        .then(|| verdem::analysis::inrun::intervals(&case, a.inrun_every, a.inrun_particle_every));
+    let report = cross::cross_inrun(
+        a.peer, &case, convention, &a.from, a.steps, a.every, a.np, &out, inrun,
     )?;
     print!("{}", report.markdown());
     println!("(saves and tables in {})", out.display());

@@ -254,16 +254,10 @@ fn in_run(
 ) -> anyhow::Result<Option<Inrun>> {
     let start = engine.state().step;
     // Intervals in contact durations (docs/statistics.md).
-    let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
-    let every =
-        every.unwrap_or_else(|| (tc_steps * inrun::CONTACTS_PER_SAMPLE).round().max(1.0) as u64);
+    let (every, particle_every) = inrun::intervals(case, every, particle_every);
     if every == 0 {
         return Ok(None);
     }
-    let particle_every = particle_every.unwrap_or_else(|| {
-        let target = inrun::CONTACTS_PER_PARTICLE_SAMPLE * tc_steps;
-        ((target / every as f64).round().max(1.0) as u64) * every
-    });
     // The saves cg averages by default: the second half of those the folder will hold.
     let first = if resumed {
         run::saves_of(&opts.out_dir, &opts.name)?

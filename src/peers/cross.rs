@@ -11,14 +11,21 @@
 //! overlaid in `profiles.png`, and compared profile by profile (χ²/dof). A peer without contact
 //! forces (Kratos DEM, [`Peer::has_contact_forces`]) is compared particle by particle only; its
 //! normal force is clipped, so verdem's is too ([`Peer::clips_normal_force`]).
+//!
+//! With in-run averaging ([`super::inrun`]) the peer also dumps its samples every K and KP
+//! steps, verdem in the peer's convention and verdem in the case's own convention average the
+//! same steps, and the three codes' profiles are compared by their core means with 95 %
+//! intervals.
 
 use std::fmt::Write;
 use std::path::Path;
 
 use anyhow::{ensure, Context};
 
+use super::inrun::{self as peer_inrun, Difference};
 use super::Peer;
 use crate::analysis::cg::{self, table::Table};
+use crate::analysis::inrun::{self, InrunResult, Sampling};
 use crate::analysis::stats::quantile;
 use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential};
@@ -55,8 +62,66 @@ pub struct SaveDiff {
     pub dw: Spread,
 }
 
+/// The in-run profiles of a cross-run, over the same steps.
+#[derive(Clone, Debug)]
+pub struct InrunReport {
+    pub sampling: Sampling,
+    /// The peer's, from its dumps.
+    pub peer: InrunResult,
+    /// verdem's in the peer's convention (the same equations).
+    pub verdem_as_peer: InrunResult,
+    /// verdem's in the case's own convention `own_convention`.
+    pub verdem: InrunResult,
+    pub own_convention: Tangential,
+}
+
+impl InrunReport {
+    /// The comparisons of a cross-run `(A, B, differences of A from B)`: the peer against
+    /// verdem in the case's convention, verdem in the peer's convention against verdem (what
+    /// the convention changes), and the peer against verdem in its own convention (the same
+    /// equations: a real difference there says the intervals are not honest).
+    pub fn comparisons(&self, peer: &str) -> Vec<(String, String, Vec<Difference>)> {
+        let own = format!("verdem ({})", self.own_convention.name());
+        let as_peer = format!("verdem as {peer}");
+        vec![
+            (
+                peer.to_string(),
+                own.clone(),
+                peer_inrun::differences(&self.peer, &self.verdem),
+            ),
+            (
+                as_peer.clone(),
+                own,
+                peer_inrun::differences(&self.verdem_as_peer, &self.verdem),
+            ),
+            (
+                peer.to_string(),
+                as_peer,
+                peer_inrun::differences(&self.peer, &self.verdem_as_peer),
+            ),
+        ]
+    }
+
+    /// The sampling and the comparisons, as markdown.
+    pub fn markdown(&self, peer: &str) -> String {
+        let s = self.sampling;
+        format!(
+            "in-run averaging over steps {}..={}: contact stress and wall forces every {} \
+             steps ({} samples), particle fields every {} steps ({} samples), bins of {} steps\n\n{}",
+            s.from + 1,
+            s.to,
+            s.every,
+            self.peer.contact_samples,
+            s.particle_every,
+            self.peer.particle_samples,
+            self.peer.bin_steps,
+            peer_inrun::markdown(&self.comparisons(peer))
+        )
+    }
+}
+
 /// A cross-run's outcome.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Report {
     pub peer: &'static dyn Peer,
     pub np: usize,
@@ -66,6 +131,8 @@ pub struct Report {
     /// saves coarse-grained, block standard errors); none when the peer gives no contact
     /// forces ([`Peer::has_contact_forces`]), without which its stresses are unknown.
     pub profiles_chi2: Option<[f64; 5]>,
+    /// The in-run profiles, when asked for.
+    pub inrun: Option<InrunReport>,
 }
 
 impl Report {
@@ -132,6 +199,9 @@ impl Report {
                 self.peer.binary()
             )
         };
+        if let Some(r) = &self.inrun {
+            let _ = write!(s, "\n{}", r.markdown(self.peer.binary()));
+        }
         s
     }
 }
@@ -153,10 +223,43 @@ pub fn cross(
     np: usize,
     out: &Path,
 ) -> anyhow::Result<Report> {
+    cross_inrun(peer, case, convention, state, steps, every, np, out, None)
+}
+
+/// [`cross`], and with `inrun` = (K, KP), the contact stress and wall forces every K steps and the particle
+/// fields every KP steps (a multiple of K; K divides `every`) are averaged in-run over steps
+/// 1..=`steps` by the peer (from its dumps; its particle dumps `particles.STEP.txt` are removed
+/// once read), by verdem in `convention` and by verdem in `case`'s own convention (a third
+/// run), and written as `PEER.profiles_inrun.csv`, `verdem.profiles_inrun.csv` and
+/// `verdem_own.profiles_inrun.csv` in `out`, their comparison ([`InrunReport::markdown`]) as
+/// `inrun.md`.
+#[allow(clippy::too_many_arguments)]
+pub fn cross_inrun(
+    peer: &'static dyn Peer,
+    case: &Case,
+    convention: Tangential,
+    state: &Path,
+    steps: u64,
+    every: u64,
+    np: usize,
+    out: &Path,
+    inrun: Option<(u64, u64)>,
+) -> anyhow::Result<Report> {
     ensure!(
         every > 0 && steps.is_multiple_of(every),
         "--every must divide --steps"
     );
+    let sampling = inrun
+        .map(|(k, kp)| {
+            ensure!(
+                k > 0 && kp > 0 && kp.is_multiple_of(k) && every.is_multiple_of(k),
+                "in-run intervals: the contact interval ({k}) must be at least 1 and divide the \
+                 particle interval ({kp}) and --every ({every})"
+            );
+            Ok(peer_inrun::sampling(steps, k, kp))
+        })
+        .transpose()?;
+    let own_case = case;
     let mut case = case.clone();
     case.contact.tangential = convention;
     case.contact.clip_normal = peer.clips_normal_force();
@@ -167,17 +270,30 @@ pub fn cross(
     let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
     e.params_mut().setup_advances_history = peer.setup_advances_history();
     e.advance(0)?;
+    let template = e.snapshot();
     let (peer_dir, own_dir) = (out.join(peer.binary()), out.join("verdem"));
     for d in [&peer_dir, &own_dir] {
         std::fs::create_dir_all(d).with_context(|| d.display().to_string())?;
     }
     let data = peer.write_state(&e.snapshot(), case.material.density, &peer_dir, "state")?;
-    let script = peer.input_script(&case, &data, steps, Some(every))?;
+    let script = match sampling {
+        None => peer.input_script(&case, &data, steps, Some(every))?,
+        Some(s) => peer
+            .inrun_script(&case, &data, steps, every, s.every, s.particle_every)
+            .with_context(|| format!("{} has no in-run dumps", peer.name()))??,
+    };
     peer.run(np, &peer_dir, &script)?;
+    let o = cg::CgOptions::for_case(&case);
+    let mut own_inrun = sampling
+        .map(|s| inrun::Inrun::new(&o, &template.domain, s))
+        .transpose()?;
     let mut saves = Vec::new();
     for k in 0..=steps / every {
         if k > 0 {
-            e.advance(every)?;
+            match own_inrun.as_mut() {
+                Some(acc) => peer_inrun::advance_observed(e.as_mut(), every, acc)?,
+                None => e.advance(every)?,
+            }
         }
         let own = e.snapshot();
         let name = format!("{}.data.{k:04}", case.name);
@@ -213,7 +329,27 @@ pub fn cross(
             dw: diff(&|i| (b.w[i] - a.w[i]).norm()),
         });
     }
-    let mut o = cg::CgOptions::for_case(&case);
+    let inrun = match (sampling, own_inrun) {
+        (Some(s), Some(acc)) => Some(InrunReport {
+            sampling: s,
+            peer: peer_profiles(peer, &peer_dir, &o, &template, s)?,
+            verdem_as_peer: acc.result().context("verdem: no in-run sample")?,
+            verdem: own_profiles(own_case, state, np, s)?,
+            own_convention: own_case.contact.tangential,
+        }),
+        _ => None,
+    };
+    if let Some(r) = &inrun {
+        atomic::write(&out.join("inrun.md"), r.markdown(peer.binary()).as_bytes())?;
+        for (name, result) in [
+            (peer.binary(), &r.peer),
+            ("verdem", &r.verdem_as_peer),
+            ("verdem_own", &r.verdem),
+        ] {
+            atomic::write(&inrun::csv_path(out, name), inrun::csv(result).as_bytes())?;
+        }
+    }
+    let mut o = o;
     o.from = Some(0);
     o.blocks = saves.len().div_ceil(4).clamp(2, 10);
     let series = |dir: &Path| cg::Series::find(&dir.join(&case.name));
@@ -241,7 +377,42 @@ pub fn cross(
         convention: case.contact.tangential,
         saves,
         profiles_chi2,
+        inrun,
     };
     atomic::write(&out.join("cross.md"), report.markdown().as_bytes())?;
     Ok(report)
+}
+
+/// The peer's in-run profiles from its dumps in `dir` ([`peer_inrun::peer_profiles`]); its
+/// particle dumps are removed once read (0.7 MB each on the benchmark).
+fn peer_profiles(
+    peer: &dyn Peer,
+    dir: &Path,
+    o: &cg::CgOptions,
+    template: &crate::state::Snapshot,
+    s: Sampling,
+) -> anyhow::Result<InrunResult> {
+    let r = peer_inrun::peer_profiles(peer, dir, o, template, s)?;
+    for entry in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
+        let path = entry?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with("particles.") && name.ends_with(".txt") {
+            std::fs::remove_file(&path).with_context(|| path.display().to_string())?;
+        }
+    }
+    Ok(r)
+}
+
+/// verdem's in-run profiles of `case` as given (its own convention and clipping), on `np`
+/// threads, from `state`, sampled as `s`; no saves.
+fn own_profiles(case: &Case, state: &Path, np: usize, s: Sampling) -> anyhow::Result<InrunResult> {
+    let overrides = Overrides {
+        threads: Some(np),
+        ..Overrides::default()
+    };
+    let mut e = engine::build(case, crate::scene::build(case, Some(state))?, &overrides);
+    e.advance(0)?;
+    let mut acc = inrun::Inrun::new(&cg::CgOptions::for_case(case), &e.state().domain, s)?;
+    peer_inrun::advance_observed(e.as_mut(), s.to, &mut acc)?;
+    acc.result().context("verdem: no in-run sample")
 }

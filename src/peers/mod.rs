@@ -14,6 +14,7 @@ use anyhow::bail;
 
 pub mod collision;
 pub mod cross;
+pub mod inrun;
 pub mod kratos;
 pub mod lammps;
 pub mod lammps_family;
@@ -103,6 +104,37 @@ pub trait Peer: Sync {
     /// Its contacts at save `step` of a run in `dir`, as verdem contacts of the state `s` (its
     /// particles at that save): P the lower index, the force on P, sorted by `(p, i)`.
     fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>>;
+
+    /// An input script as [`Peer::input_script`] with a save every `every` steps, that also
+    /// dumps what in-run averaging samples ([`Peer::read_sample`]): the contact forces and the
+    /// positions of the spheres in contact every `contact_every` steps, all particles every
+    /// `particle_every` steps; `None` when the peer has no such dumps.
+    fn inrun_script(
+        &self,
+        _case: &Case,
+        _state: &str,
+        _steps: u64,
+        _every: u64,
+        _contact_every: u64,
+        _particle_every: u64,
+    ) -> Option<anyhow::Result<String>> {
+        None
+    }
+
+    /// The in-run sample at `step` of a run of [`Peer::inrun_script`] in `dir`, as a snapshot
+    /// of `template`'s particles (ids, motion, domain) at that step: the spheres in contact at
+    /// their dumped positions with the peer's contacts (as [`Peer::read_contacts`]), and, when
+    /// `particles`, every particle's radius, position, velocity and spin; the other particles
+    /// keep `template`'s values.
+    fn read_sample(
+        &self,
+        _dir: &Path,
+        _step: u64,
+        _template: &Snapshot,
+        _particles: bool,
+    ) -> anyhow::Result<Snapshot> {
+        bail!("{} has no in-run dumps", self.name())
+    }
 
     /// Whether [`Peer::read_contacts`] can give its contact forces at all (a cross-run without
     /// them compares particles only).

@@ -135,9 +135,20 @@ pub fn read(path: &Path) -> Result<Frame, FormatError> {
     parse(&mut crate::io::open(path)?)
 }
 
-/// Parses a dump of one frame; errors name the file and line (those of `read_table`, other
-/// columns than [`DUMP_COLUMNS`], ids not 1…N in order, a radius that is not positive).
-pub fn parse<R: BufRead>(lines: &mut Lines<R>) -> Result<Frame, FormatError> {
+/// One particle of a dump: its id (from 1) and its values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Atom {
+    pub id: usize,
+    pub radius: f64,
+    pub x: Vec3,
+    pub v: Vec3,
+    pub w: Vec3,
+}
+
+/// The step and the particles of a dump of [`DUMP_COLUMNS`], with the line of each; errors
+/// name the file and line (those of `read_table`, other columns, an id that is not a whole
+/// number from 1, a radius that is not positive).
+fn atoms<R: BufRead>(lines: &mut Lines<R>) -> Result<(u64, Vec<Atom>, Vec<usize>), FormatError> {
     let t = read_table(
         lines,
         "ITEM: NUMBER OF ATOMS",
@@ -156,30 +167,62 @@ pub fn parse<R: BufRead>(lines: &mut Lines<R>) -> Result<Frame, FormatError> {
             format!("columns must be `{}`", DUMP_COLUMNS.join(" ")),
         ));
     }
-    let n = t.rows.len();
+    let mut atoms = Vec::with_capacity(t.rows.len());
+    for (r, &line) in t.rows.iter().zip(&t.line) {
+        if !(r[0] >= 1.0 && r[0].fract() == 0.0) {
+            return Err(err(
+                line,
+                format!("id: expected a whole number >= 1, got {}", r[0]),
+            ));
+        }
+        if r[2] <= 0.0 {
+            return Err(err(line, format!("radius: must be > 0, got {}", r[2])));
+        }
+        atoms.push(Atom {
+            id: r[0] as usize,
+            radius: r[2],
+            x: Vec3::new(r[3], r[4], r[5]),
+            v: Vec3::new(r[6], r[7], r[8]),
+            w: Vec3::new(r[9], r[10], r[11]),
+        });
+    }
+    Ok((t.step, atoms, t.line))
+}
+
+/// Parses a dump of one frame; errors name the file and line (those of [`atoms`], ids not
+/// 1…N in order).
+pub fn parse<R: BufRead>(lines: &mut Lines<R>) -> Result<Frame, FormatError> {
+    let file = lines.file().to_string();
+    let (step, atoms, line) = atoms(lines)?;
+    let n = atoms.len();
     let mut frame = Frame {
-        step: t.step,
+        step,
         radius: Vec::with_capacity(n),
         x: Vec::with_capacity(n),
         v: Vec::with_capacity(n),
         w: Vec::with_capacity(n),
     };
-    for (a, r) in t.rows.iter().enumerate() {
-        if r[0] != (a + 1) as f64 {
+    for (a, atom) in atoms.into_iter().enumerate() {
+        if atom.id != a + 1 {
             return Err(err(
-                t.line[a],
-                format!("id: expected {} (sorted ids 1..N), got {}", a + 1, r[0]),
+                &file,
+                line[a],
+                format!("id: expected {} (sorted ids 1..N), got {}", a + 1, atom.id),
             ));
         }
-        if r[2] <= 0.0 {
-            return Err(err(t.line[a], format!("radius: must be > 0, got {}", r[2])));
-        }
-        frame.radius.push(r[2]);
-        frame.x.push(Vec3::new(r[3], r[4], r[5]));
-        frame.v.push(Vec3::new(r[6], r[7], r[8]));
-        frame.w.push(Vec3::new(r[9], r[10], r[11]));
+        frame.radius.push(atom.radius);
+        frame.x.push(atom.x);
+        frame.v.push(atom.v);
+        frame.w.push(atom.w);
     }
     Ok(frame)
+}
+
+/// Reads a dump of some of the particles (any ids, as `dump_modify thresh` leaves them): its
+/// step and particles. Errors as [`parse`]'s, without the order of ids.
+pub fn read_atoms(path: &Path) -> Result<(u64, Vec<Atom>), FormatError> {
+    let (step, atoms, _) = atoms(&mut crate::io::open(path)?)?;
+    Ok((step, atoms))
 }
 
 /// Reads a `dump local` file of `columns` numbers per entry (the contact forces of a save).
