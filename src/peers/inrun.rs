@@ -109,7 +109,10 @@ impl CoreMean {
             mean,
             se,
             blocks,
-            long_enough: r.errors.long_enough[c],
+            long_enough: matches!(
+                r.errors.method[c],
+                crate::analysis::cg::blocking::Method::Blocks
+            ),
         }
     }
 }
