@@ -60,12 +60,13 @@ fn col(name: &str) -> usize {
 
 /// χ²/dof of a profile against its mirror image about the mid-plane (`sign` −1 for an
 /// antisymmetric one) over the pairs of slices k and n − 1 − k, with the pairs left out. A slice
-/// whose value is not zero but whose blocks agree to round-off (a slice the particles barely
-/// reach: each block's value derived from almost nothing) has no measured error; its pair is
-/// left out and counted rather than divided by a zero-like error.
+/// whose error is not zero but below round-off of its value (blocks that differ only in their
+/// last bits: a slice the particles barely reach) has no measured error; its pair is left out
+/// and counted rather than divided by a round-off error. An error of exactly zero (identical
+/// blocks) keeps its meaning: any difference from the mirror is then real.
 fn mirror_chi2(values: &[f64], errors: &[f64], sign: f64) -> (f64, usize) {
     let n = values.len();
-    let unmeasured = |k: usize| values[k] != 0.0 && errors[k] <= 1e-9 * values[k].abs();
+    let unmeasured = |k: usize| errors[k] > 0.0 && errors[k] <= 1e-9 * values[k].abs();
     let (kept, left): (Vec<usize>, Vec<usize>) =
         (0..n / 2).partition(|&k| !(unmeasured(k) || unmeasured(n - 1 - k)));
     let sum: f64 = kept
@@ -419,6 +420,11 @@ mod tests {
         let (chi, left) = mirror_chi2(&values, &measured, 1.0);
         assert_eq!(left, 0);
         assert!(chi > 100.0, "{chi}");
+        // an error of exactly zero is identical blocks: the asymmetry is real
+        let exact = [0.0, 0.1, 0.1, 0.1, 0.1, 0.0];
+        let (chi, left) = mirror_chi2(&values, &exact, 1.0);
+        assert_eq!(left, 0);
+        assert!(chi.is_infinite(), "{chi}");
         // antisymmetric: -v mirrors v
         let (chi, _) = mirror_chi2(&[-1.0, 0.5, -0.5, 1.0], &[0.1; 4], -1.0);
         assert!(chi < 1e-12, "{chi}");
