@@ -866,13 +866,14 @@ mod tests {
         let m = [measured(1, 2, &[100.0, 110.05]), peer];
         let mut at = AtSize::without_memory(10, 500, m.to_vec());
         at.peak_rss[1] = Some(2048.0);
-        // no verdem row of one copy: no "verdem best", no 2/1 ratio; ns = 1e9 / (2 × 10)
+        // no verdem row of one copy: no "verdem best", no 2/1 ratio; ns = 1e9 / (105.025 × 10)
+        // and 1e9 / (2 × 10); 2048 bytes over 10 particles
         assert_eq!(
             csv(&[at]),
             "code,procs,median_steps_per_s,particle_steps_per_s,rounds,particles,steps,\
              ns_per_particle_step,verdem_best_over_this,verdem_2_over_1_threads,\
              peak_rss_bytes_per_particle\n\
-             2 independent verdem runs at once (summed),2×1,105.0,1050.2,100.0 110.0,10,500,952380.952,,,\n\
+             2 independent verdem runs at once (summed),2×1,105.0,1050.2,100.0 110.0,10,500,952154.249,,,\n\
              lammps,2,2.0,20.0,1.0 3.0,10,500,50000000.000,,,205\n"
         );
     }
