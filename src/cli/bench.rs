@@ -19,6 +19,10 @@ const DEVELOPING: &str = "data/states/mercury_t143.85.data";
 /// The state a sweep tiles: verdem's full run's final state, so that every code starts steady.
 const STEADY: &str = "golden/full_run/shear_flow.final.data";
 
+/// The peers a sweep times unless --peers names others (Yade and Kratos, far slower, when
+/// named).
+const SWEPT_PEERS: &str = "lammps,liggghts";
+
 #[derive(clap::Args)]
 pub struct Args {
     /// Case file (default: cases/shear_flow_quick.toml).
@@ -41,9 +45,10 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     threads: Vec<usize>,
     /// Peers to run, comma-separated (`verdem peers` lists them; none: --peers ''). The default
-    /// leaves out Kratos DEM, about 100 times slower than LAMMPS: name it, with fewer --steps.
-    #[arg(long, default_value_t = verdem::peers::bench_names())]
-    peers: String,
+    /// leaves out Kratos DEM, about 100 times slower than LAMMPS: name it, with fewer --steps;
+    /// with --scale it is lammps,liggghts (name Yade and Kratos to sweep them too).
+    #[arg(long)]
+    peers: Option<String>,
     /// MPI ranks (Yade: OpenMP threads) for the peers.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     np: Vec<usize>,
@@ -99,7 +104,14 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             lockstep,
         }));
     }
-    for peer in verdem::peers::parse_list(&a.peers).context("--peers")? {
+    let peers = a.peers.clone().unwrap_or_else(|| {
+        if a.scale.is_empty() {
+            verdem::peers::bench_names()
+        } else {
+            SWEPT_PEERS.to_string()
+        }
+    });
+    for peer in verdem::peers::parse_list(&peers).context("--peers")? {
         configs.extend(a.np.iter().map(|&n| Config::Peer { peer, np: n }));
     }
     if !a.scale.is_empty() {
