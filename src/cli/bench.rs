@@ -137,12 +137,11 @@ fn sweep(a: &Args, case_path: &Path, configs: &[Config]) -> anyhow::Result<Finis
     let mut sizes = Vec::new();
     for &n in &a.scale {
         let work = a.out.join(format!("{n}x{n}"));
-        let (case, state) = verdem::tile::write(case_path, &from, n, n, &work)?;
-        let particles = scene::build(&Case::load(&case)?, Some(&state))?
-            .particles
-            .len();
+        let (case_file, state) = verdem::tile::write(case_path, &from, n, n, &work)?;
+        let case = Case::load(&case_file)?;
+        let particles = scene::build(&case, Some(&state))?.particles.len();
         sizes.push(Size {
-            case: Case::load(&case)?,
+            case,
             state,
             particles,
             steps: bench::steps_for(a.particle_steps, particles),
