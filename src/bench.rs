@@ -129,18 +129,47 @@ fn peer_states(
     for c in configs {
         if let Config::Peer { peer, .. } = c {
             if states.iter().all(|(name, _)| *name != peer.name()) {
-                let e = engine::build(
-                    case,
-                    crate::scene::build(case, Some(state))?,
-                    &Overrides::default(),
-                );
-                let file = peer.write_state(&e.snapshot(), case.material.density, work, "state")?;
-                let path = work.join(file).canonicalize()?;
+                let path = write_peer_state(case, state, *peer, work, "state")?;
                 states.push((peer.name(), path.display().to_string()));
             }
         }
     }
     Ok(states)
+}
+
+/// Writes the state file `state` of `case` in `peer`'s format into `work` under the stem
+/// `stem`; returns its absolute path.
+pub fn write_peer_state(
+    case: &Case,
+    state: &Path,
+    peer: &dyn Peer,
+    work: &Path,
+    stem: &str,
+) -> anyhow::Result<std::path::PathBuf> {
+    let e = engine::build(
+        case,
+        crate::scene::build(case, Some(state))?,
+        &Overrides::default(),
+    );
+    let file = peer.write_state(&e.snapshot(), case.material.density, work, stem)?;
+    let path = work.join(file);
+    path.canonicalize()
+        .with_context(|| path.display().to_string())
+}
+
+/// Runs `peer` once on `np` processes in `dir` (created), `steps` steps of `case` from its own
+/// state file `data` ([`write_peer_state`]), no file output; returns its loop's seconds.
+pub fn run_peer(
+    case: &Case,
+    peer: &dyn Peer,
+    np: usize,
+    data: &Path,
+    steps: u64,
+    dir: &Path,
+) -> anyhow::Result<f64> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let script = peer.input_script(case, &data.display().to_string(), steps, None)?;
+    peer.run(np, dir, &script)
 }
 
 /// One round: every configuration of `out` once, in order, `steps` steps from `state`; each
@@ -217,10 +246,9 @@ fn round(
                 let data = states
                     .iter()
                     .find(|(name, _)| *name == peer.name())
-                    .map(|(_, path)| path.as_str())
+                    .map(|(_, path)| Path::new(path))
                     .expect("every peer's state is written before the rounds");
-                let script = peer.input_script(case, data, steps, None)?;
-                let seconds = peer.run(*np, &dir, &script)?;
+                let seconds = run_peer(case, *peer, *np, data, steps, &dir)?;
                 m.rates.push(steps as f64 / seconds);
             }
         }
@@ -496,18 +524,31 @@ pub fn sweep(sizes: &[Size], configs: &[Config], rounds: usize) -> anyhow::Resul
     Ok(out)
 }
 
-/// The peak resident memory (bytes) of this process (`children` false) or of the largest of
-/// its waited-for descendants (`children` true; the kernel keeps the largest one's, not their
-/// sum), from `getrusage`; `None` where it fails.
-pub fn peak_rss(children: bool) -> Option<f64> {
-    let who = if children {
-        libc::RUSAGE_CHILDREN
-    } else {
-        libc::RUSAGE_SELF
-    };
+/// The peak resident memory (bytes) of this process's own address space (`VmHWM` in
+/// `/proc/self/status`): unlike `getrusage`'s, it starts afresh at `exec`, so that a process
+/// started by a large one (`vfork` and `exec`, as `std::process::Command` does) does not
+/// inherit its parent's peak. `None` where the file or the line is missing.
+pub fn own_peak_rss() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))?
+        .trim()
+        .strip_suffix("kB")?
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The peak resident memory (bytes) of the largest of this process's waited-for descendants,
+/// from `getrusage(RUSAGE_CHILDREN)` (the kernel keeps the largest one's, not their sum; a
+/// child started by `vfork` and `exec` counts this process's own peak at that moment too);
+/// `None` where it fails.
+pub fn children_peak_rss() -> Option<f64> {
     // SAFETY: getrusage writes one `rusage` into the zeroed struct it is given.
     let mut u: libc::rusage = unsafe { std::mem::zeroed() };
-    let done = unsafe { libc::getrusage(who, &mut u) } == 0;
+    let done = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut u) } == 0;
     // ru_maxrss is in KiB on Linux
     (done && u.ru_maxrss > 0).then_some(u.ru_maxrss as f64 * 1024.0)
 }

@@ -112,6 +112,13 @@ fn a_sweep_of_verdem_alone_writes_every_size_with_memory_and_the_plot() {
         // a process holds at least a megabyte (its program and libraries)
         assert!(number(r, "peak_rss_bytes_per_particle") * n > 1e6, "{r:?}");
     }
+    // each probe's own memory, not the sweep's: four times the particles hold more (positions,
+    // velocities, spins, contacts: far over 100 bytes each of the 10440 more)
+    let total =
+        |k: usize| number(&rows[k], "peak_rss_bytes_per_particle") * number(&rows[k], "particles");
+    for (small, large) in [(0, 2), (1, 3)] {
+        assert!(total(large) > total(small) + 1e6, "{rows:?}");
+    }
 }
 
 #[test]

@@ -174,7 +174,7 @@ fn sweep_header(a: &Args, case_path: &Path, from: &Path, sizes: &[Size]) -> Stri
         .collect();
     format!(
         "{} tiled n × n in x–y from {} ({}); each run about {} particle-steps; {} alternating rounds (each round every size in turn, each size every configuration in turn); {} cores ({}); no file output in the timed region.\n\
-Peak resident memory: one more run of each configuration at each size ({} steps at most) in a child process, its peak resident set from getrusage (verdem: the child's own, scene and state reading included; a peer: the largest of mpirun and its ranks, times the ranks, which the kernel does not sum), over the particles.\n\n",
+Peak resident memory: one more run of each configuration at each size ({} steps at most) in a child process, its peak resident set (verdem: the child's own, VmHWM, state reading and scene included; a peer: the largest of mpirun and its ranks from getrusage, times the ranks, as the kernel does not sum them), over the particles.\n\n",
         case_path.display(),
         from.display(),
         list.join("; "),
@@ -190,22 +190,28 @@ Peak resident memory: one more run of each configuration at each size ({} steps 
 const PROBE_STEPS: u64 = 200;
 
 /// The peak resident memory (bytes) of one process of configuration `c` run at size `z`, from a
-/// child `verdem bench --probe`.
+/// child `verdem bench --probe` (a peer's probe reads the peer's state file written here, so
+/// that the probe itself stays small: its children count its peak).
 fn probe_memory(z: &Size, c: &Config) -> anyhow::Result<f64> {
-    let probe = match c {
-        Config::Verdem { threads, .. } => format!("verdem:{threads}"),
-        Config::Peer { peer, np } => format!("{}:{np}", peer.name()),
+    let dir = |probe: &str| z.work.join(format!("probe-{}", probe.replace(':', "-")));
+    let (probe, from) = match c {
+        Config::Verdem { threads, .. } => (format!("verdem:{threads}"), z.state.clone()),
+        Config::Peer { peer, np } => {
+            let probe = format!("{}:{np}", peer.name());
+            let data = bench::write_peer_state(&z.case, &z.state, *peer, &z.work, "probe")?;
+            (probe, data)
+        }
     };
     let exe = std::env::current_exe().context("the path of the verdem program")?;
     let out = Command::new(&exe)
         .arg("bench")
         .arg(&z.case.path)
         .arg("--from")
-        .arg(&z.state)
+        .arg(&from)
         .args(["--steps", &z.steps.min(PROBE_STEPS).to_string()])
         .args(["--probe", &probe])
         .arg("--out")
-        .arg(z.work.join(format!("probe-{}", probe.replace(':', "-"))))
+        .arg(dir(&probe))
         .output()
         .with_context(|| format!("cannot start {}", exe.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
@@ -222,8 +228,9 @@ fn probe_memory(z: &Size, c: &Config) -> anyhow::Result<f64> {
         .with_context(|| format!("the memory probe {probe} printed no peak_rss_bytes: {text}"))
 }
 
-/// `--probe`: runs one configuration once from `from` and prints `peak_rss_bytes B`, this
-/// process's peak (verdem) or its largest child's (a peer).
+/// `--probe`: runs one configuration once and prints `peak_rss_bytes B`: verdem from the state
+/// `from`, its own peak ([`bench::own_peak_rss`]); a peer from its own state file `from`, its
+/// largest process's peak ([`bench::children_peak_rss`]).
 fn run_probe(
     case: &Case,
     from: &Path,
@@ -235,21 +242,20 @@ fn run_probe(
         .split_once(':')
         .with_context(|| format!("--probe {probe}: CODE:N expected"))?;
     let n: usize = count(n).map_err(anyhow::Error::msg)?;
-    let config = if code == "verdem" {
-        Config::Verdem {
+    let bytes = if code == "verdem" {
+        let config = Config::Verdem {
             threads: n,
             copies: 1,
             lockstep: false,
-        }
+        };
+        bench::run(case, from, steps, &[config], 1, out)?;
+        bench::own_peak_rss()
     } else {
-        Config::Peer {
-            peer: verdem::peers::by_name(code)?,
-            np: n,
-        }
+        let peer = verdem::peers::by_name(code)?;
+        bench::run_peer(case, peer, n, from, steps, out)?;
+        bench::children_peak_rss()
     };
-    let children = matches!(config, Config::Peer { .. });
-    bench::run(case, from, steps, &[config], 1, out)?;
-    let bytes = bench::peak_rss(children).context("getrusage gave no peak resident memory")?;
+    let bytes = bytes.context("no peak resident memory (/proc/self/status, getrusage)")?;
     println!("peak_rss_bytes {bytes:.0}");
     Ok(Finished::Done)
 }
