@@ -96,24 +96,17 @@ pub fn run(
     rounds: usize,
     work: &Path,
 ) -> anyhow::Result<Vec<Measured>> {
-    std::fs::create_dir_all(work).with_context(|| work.display().to_string())?;
-    // each peer's state file in `work`, by peer name, written once before the rounds
-    let mut states: Vec<(&str, String)> = Vec::new();
-    for c in configs {
-        if let Config::Peer { peer, .. } = c {
-            if states.iter().all(|(name, _)| *name != peer.name()) {
-                let e = engine::build(
-                    case,
-                    crate::scene::build(case, Some(state))?,
-                    &Overrides::default(),
-                );
-                let file = peer.write_state(&e.snapshot(), case.material.density, work, "state")?;
-                let path = work.join(file).canonicalize()?;
-                states.push((peer.name(), path.display().to_string()));
-            }
-        }
+    let states = peer_states(case, state, configs, work)?;
+    let mut out = unmeasured(configs);
+    for _ in 0..rounds {
+        round(case, state, steps, &states, work, &mut out)?;
     }
-    let mut out: Vec<Measured> = configs
+    Ok(out)
+}
+
+/// Each configuration with no rate yet.
+fn unmeasured(configs: &[Config]) -> Vec<Measured> {
+    configs
         .iter()
         .map(|c| Measured {
             config: c.clone(),
@@ -121,81 +114,146 @@ pub fn run(
             copy_rates: Vec::new(),
             stages: None,
         })
-        .collect();
-    for _ in 0..rounds {
-        for m in out.iter_mut() {
-            match &m.config {
-                Config::Verdem {
-                    threads,
-                    copies,
-                    lockstep,
-                } => {
-                    let barrier = lockstep.then(|| Arc::new(SpinBarrier::new(*copies)));
-                    let mut engines = (0..*copies)
-                        .map(|_| {
-                            let mut e = engine::build(
-                                case,
-                                crate::scene::build(case, Some(state))?,
-                                &Overrides {
-                                    threads: Some(*threads),
-                                    ..Overrides::default()
-                                },
-                            );
-                            e.advance(0)?;
-                            *e.counters_mut() = StageTimes::default();
-                            e.params_mut().meet = barrier
-                                .clone()
-                                .map(|b| Arc::new(move || b.wait()) as crate::step::MeetHook);
-                            Ok(e)
-                        })
-                        .collect::<anyhow::Result<Vec<_>>>()?;
-                    let copies = *copies;
-                    let start = std::sync::Barrier::new(copies);
-                    let time_copy = |k: usize, e: &mut dyn crate::step::Engine| {
-                        let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
-                        start.wait();
-                        let t0 = Instant::now();
-                        advance_in_chunks(e, steps)?;
-                        Ok::<f64, crate::step::guard::Failure>(
-                            steps as f64 / t0.elapsed().as_secs_f64(),
-                        )
-                    };
-                    let own: Vec<f64> = std::thread::scope(|s| {
-                        let (first, rest) = engines.split_at_mut(1);
-                        let others: Vec<_> = rest
-                            .iter_mut()
-                            .enumerate()
-                            .map(|(k, e)| {
-                                let time_copy = &time_copy;
-                                s.spawn(move || time_copy(k + 1, e.as_mut()))
-                            })
-                            .collect();
-                        let mut own = vec![time_copy(0, first[0].as_mut())];
-                        own.extend(others.into_iter().map(|h| h.join().expect("copy runs")));
-                        own.into_iter().collect::<Result<Vec<f64>, _>>()
-                    })?;
-                    m.rates.push(own.iter().sum());
-                    if copies > 1 {
-                        m.copy_rates.push(own);
-                    }
-                    m.stages = Some(*engines[0].counters());
-                }
-                Config::Peer { peer, np } => {
-                    let dir = work.join(format!("{}-{np}", peer.binary()));
-                    std::fs::create_dir_all(&dir)?;
-                    let data = states
-                        .iter()
-                        .find(|(name, _)| *name == peer.name())
-                        .map(|(_, path)| path.as_str())
-                        .expect("every peer's state is written before the rounds");
-                    let script = peer.input_script(case, data, steps, None)?;
-                    let seconds = peer.run(*np, &dir, &script)?;
-                    m.rates.push(steps as f64 / seconds);
-                }
+        .collect()
+}
+
+/// Each peer's state file in `work` (created), by peer name, for the peers of `configs`.
+fn peer_states(
+    case: &Case,
+    state: &Path,
+    configs: &[Config],
+    work: &Path,
+) -> anyhow::Result<Vec<(&'static str, String)>> {
+    std::fs::create_dir_all(work).with_context(|| work.display().to_string())?;
+    let mut states: Vec<(&str, String)> = Vec::new();
+    for c in configs {
+        if let Config::Peer { peer, .. } = c {
+            if states.iter().all(|(name, _)| *name != peer.name()) {
+                let path = write_peer_state(case, state, *peer, work, "state")?;
+                states.push((peer.name(), path.display().to_string()));
             }
         }
     }
-    Ok(out)
+    Ok(states)
+}
+
+/// Writes the state file `state` of `case` in `peer`'s format into `work` under the stem
+/// `stem`; returns its absolute path.
+pub fn write_peer_state(
+    case: &Case,
+    state: &Path,
+    peer: &dyn Peer,
+    work: &Path,
+    stem: &str,
+) -> anyhow::Result<std::path::PathBuf> {
+    let e = engine::build(
+        case,
+        crate::scene::build(case, Some(state))?,
+        &Overrides::default(),
+    );
+    let file = peer.write_state(&e.snapshot(), case.material.density, work, stem)?;
+    let path = work.join(file);
+    path.canonicalize()
+        .with_context(|| path.display().to_string())
+}
+
+/// Runs `peer` once on `np` processes in `dir` (created), `steps` steps of `case` from its own
+/// state file `data` ([`write_peer_state`]), no file output; returns its loop's seconds.
+pub fn run_peer(
+    case: &Case,
+    peer: &dyn Peer,
+    np: usize,
+    data: &Path,
+    steps: u64,
+    dir: &Path,
+) -> anyhow::Result<f64> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let script = peer.input_script(case, &data.display().to_string(), steps, None)?;
+    peer.run(np, dir, &script)
+}
+
+/// One round: every configuration of `out` once, in order, `steps` steps from `state`; each
+/// appends its rate. Peers read their state files `states` ([`peer_states`]) and run in
+/// `work`.
+fn round(
+    case: &Case,
+    state: &Path,
+    steps: u64,
+    states: &[(&'static str, String)],
+    work: &Path,
+    out: &mut [Measured],
+) -> anyhow::Result<()> {
+    for m in out.iter_mut() {
+        match &m.config {
+            Config::Verdem {
+                threads,
+                copies,
+                lockstep,
+            } => {
+                let barrier = lockstep.then(|| Arc::new(SpinBarrier::new(*copies)));
+                let mut engines = (0..*copies)
+                    .map(|_| {
+                        let mut e = engine::build(
+                            case,
+                            crate::scene::build(case, Some(state))?,
+                            &Overrides {
+                                threads: Some(*threads),
+                                ..Overrides::default()
+                            },
+                        );
+                        e.advance(0)?;
+                        *e.counters_mut() = StageTimes::default();
+                        e.params_mut().meet = barrier
+                            .clone()
+                            .map(|b| Arc::new(move || b.wait()) as crate::step::MeetHook);
+                        Ok(e)
+                    })
+                    .collect::<anyhow::Result<Vec<_>>>()?;
+                let copies = *copies;
+                let start = std::sync::Barrier::new(copies);
+                let time_copy = |k: usize, e: &mut dyn crate::step::Engine| {
+                    let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
+                    start.wait();
+                    let t0 = Instant::now();
+                    advance_in_chunks(e, steps)?;
+                    Ok::<f64, crate::step::guard::Failure>(
+                        steps as f64 / t0.elapsed().as_secs_f64(),
+                    )
+                };
+                let own: Vec<f64> = std::thread::scope(|s| {
+                    let (first, rest) = engines.split_at_mut(1);
+                    let others: Vec<_> = rest
+                        .iter_mut()
+                        .enumerate()
+                        .map(|(k, e)| {
+                            let time_copy = &time_copy;
+                            s.spawn(move || time_copy(k + 1, e.as_mut()))
+                        })
+                        .collect();
+                    let mut own = vec![time_copy(0, first[0].as_mut())];
+                    own.extend(others.into_iter().map(|h| h.join().expect("copy runs")));
+                    own.into_iter().collect::<Result<Vec<f64>, _>>()
+                })?;
+                m.rates.push(own.iter().sum());
+                if copies > 1 {
+                    m.copy_rates.push(own);
+                }
+                m.stages = Some(*engines[0].counters());
+            }
+            Config::Peer { peer, np } => {
+                let dir = work.join(format!("{}-{np}", peer.binary()));
+                std::fs::create_dir_all(&dir)?;
+                let data = states
+                    .iter()
+                    .find(|(name, _)| *name == peer.name())
+                    .map(|(_, path)| Path::new(path))
+                    .expect("every peer's state is written before the rounds");
+                let seconds = run_peer(case, *peer, *np, data, steps, &dir)?;
+                m.rates.push(steps as f64 / seconds);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Advances `steps` steps in chunks as a run does (progress and saves happen between them).
@@ -242,19 +300,25 @@ fn interval(found: Option<(f64, f64)>) -> String {
 /// measured value is the median (NaN for no values), the interval is its text; a goal does not
 /// gate.
 fn goal_verdict(quantity: &str, r: &[f64], goal: f64) -> Verdict {
+    limit_verdict(quantity, r, Limit::AtLeast(goal), format!("≥ {goal}"))
+}
+
+/// As [`goal_verdict`] for any one-sided `limit` (a [`Limit::AtLeast`] or [`Limit::Below`]),
+/// shown as `expected`.
+fn limit_verdict(quantity: &str, r: &[f64], limit: Limit, expected: String) -> Verdict {
     let found = median_interval(r, CONFIDENCE);
     let outcome = match found {
-        Some((lo, _)) if lo >= goal => Outcome::Pass,
-        Some((_, hi)) if hi < goal => Outcome::Fail,
+        Some((lo, hi)) if limit.admits(lo) && limit.admits(hi) => Outcome::Pass,
+        Some((lo, hi)) if !limit.admits(lo) && !limit.admits(hi) => Outcome::Fail,
         _ => Outcome::Undecided,
     };
     let measured = if r.is_empty() { f64::NAN } else { median(r) };
     Verdict {
         outcome,
         gate: false,
-        ..Verdict::judge("", quantity, measured, Limit::AtLeast(goal))
+        ..Verdict::judge("", quantity, measured, limit)
     }
-    .described(interval(found), format!("≥ {goal}"))
+    .described(interval(found), expected)
 }
 
 /// A goal's verdict in words: "met", "not met" or "undecided", followed by the interval.
@@ -383,10 +447,272 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
     s
 }
 
-/// The table as CSV: code, processes/threads, median steps/s, particle-steps/s, the rounds'
-/// steps/s separated by spaces; fields quoted (RFC 4180) when they hold a comma, a quote or a
-/// line break.
-pub fn csv(m: &[Measured], particles: usize) -> String {
+/// One system size of a sweep: a (tiled) case, its state, and the steps each run takes there.
+#[derive(Clone, Debug)]
+pub struct Size {
+    pub case: Case,
+    pub state: std::path::PathBuf,
+    pub particles: usize,
+    pub steps: u64,
+    /// Where its peers' inputs and runs go.
+    pub work: std::path::PathBuf,
+}
+
+/// The steps that make about `particle_steps` particle-steps with `particles` particles
+/// (rounded, at least 1): runs of one sweep then take about the same time at every size when
+/// the cost per particle-step is flat.
+pub fn steps_for(particle_steps: u64, particles: usize) -> u64 {
+    ((particle_steps as f64 / particles.max(1) as f64).round() as u64).max(1)
+}
+
+/// The measurements at one size: the rates of every configuration and, where measured, the
+/// peak resident memory of a run of each (bytes, over all its processes: [`processes`]).
+#[derive(Clone, Debug)]
+pub struct AtSize {
+    pub particles: usize,
+    pub steps: u64,
+    pub measured: Vec<Measured>,
+    pub peak_rss: Vec<Option<f64>>,
+}
+
+impl AtSize {
+    /// The measurements of one size without memory figures.
+    pub fn without_memory(particles: usize, steps: u64, measured: Vec<Measured>) -> AtSize {
+        let peak_rss = vec![None; measured.len()];
+        AtSize {
+            particles,
+            steps,
+            measured,
+            peak_rss,
+        }
+    }
+}
+
+/// The processes a configuration runs as: a peer's MPI ranks when it is started by `mpirun`
+/// (else 1: Yade's threads share one process), one for verdem; `None` for the ceiling rows,
+/// whose memory is not a code's.
+pub fn processes(c: &Config) -> Option<usize> {
+    match c {
+        Config::Verdem { copies: 1, .. } => Some(1),
+        Config::Verdem { .. } => None,
+        Config::Peer { peer, np } => Some(if peer.command_line(*np).starts_with("mpirun") {
+            *np
+        } else {
+            1
+        }),
+    }
+}
+
+/// Runs every size of `sizes` with every configuration, `rounds` times: each round runs every
+/// size in turn and, at each size, every configuration in turn (so that a drift of the machine
+/// falls alike on all, and the ratios across sizes are paired by round too).
+pub fn sweep(sizes: &[Size], configs: &[Config], rounds: usize) -> anyhow::Result<Vec<AtSize>> {
+    let states = sizes
+        .iter()
+        .map(|z| peer_states(&z.case, &z.state, configs, &z.work))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut out: Vec<AtSize> = sizes
+        .iter()
+        .map(|z| AtSize::without_memory(z.particles, z.steps, unmeasured(configs)))
+        .collect();
+    for _ in 0..rounds {
+        for ((z, st), at) in sizes.iter().zip(&states).zip(out.iter_mut()) {
+            round(&z.case, &z.state, z.steps, st, &z.work, &mut at.measured)
+                .with_context(|| format!("{} particles", z.particles))?;
+        }
+    }
+    Ok(out)
+}
+
+/// The peak resident memory (bytes) of this process's own address space (`VmHWM` in
+/// `/proc/self/status`): unlike `getrusage`'s, it starts afresh at `exec`, so that a process
+/// started by a large one (`vfork` and `exec`, as `std::process::Command` does) does not
+/// inherit its parent's peak. `None` where the file or the line is missing.
+pub fn own_peak_rss() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))?
+        .trim()
+        .strip_suffix("kB")?
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The peak resident memory (bytes) of the largest of this process's waited-for descendants,
+/// from `getrusage(RUSAGE_CHILDREN)` (the kernel keeps the largest one's, not their sum; a
+/// child started by `vfork` and `exec` counts this process's own peak at that moment too);
+/// `None` where it fails.
+pub fn children_peak_rss() -> Option<f64> {
+    // SAFETY: getrusage writes one `rusage` into the zeroed struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    let done = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut u) } == 0;
+    // ru_maxrss is in KiB on Linux
+    (done && u.ru_maxrss > 0).then_some(u.ru_maxrss as f64 * 1024.0)
+}
+
+/// The speed-up of 2 threads over 1 asked of verdem in a sweep, at sizes of at least
+/// [`SCALE_SPEEDUP_FROM`] particles (where the meeting once a step is amortised).
+const SCALE_SPEEDUP_GOAL: f64 = 1.8;
+
+/// The smallest size at which a sweep judges [`SCALE_SPEEDUP_GOAL`] (the 4×4 tiling).
+const SCALE_SPEEDUP_FROM: usize = 55_680;
+
+/// The largest spread of verdem's cost per particle-step across the sizes of a sweep (the
+/// costliest size's over the cheapest's).
+const SPREAD_GOAL: f64 = 1.5;
+
+/// Verdem's configuration of `threads` threads (one copy) among `m`.
+fn verdem_of(m: &[Measured], threads: usize) -> Option<&Measured> {
+    m.iter().find(|x| {
+        x.config
+            == Config::Verdem {
+                threads,
+                copies: 1,
+                lockstep: false,
+            }
+    })
+}
+
+/// The fastest (highest median) of the configurations of `m` that `keep` selects.
+fn fastest(m: &[Measured], keep: impl Fn(&Config) -> bool) -> Option<&Measured> {
+    m.iter()
+        .filter(|x| keep(&x.config))
+        .max_by(|a, b| a.median().total_cmp(&b.median()))
+}
+
+/// Cost per particle-step (ns) at the rate `steps_per_s` with `particles` particles.
+fn ns_per_particle_step(steps_per_s: f64, particles: usize) -> f64 {
+    1e9 / (steps_per_s * particles as f64)
+}
+
+/// The sweep's tables as markdown: one summary row per size and configuration (particles,
+/// steps, code, processes/threads, steps/s, particle-steps/s, ns per particle-step, verdem's
+/// best rate over the code's, peak memory per particle), the goals judged with intervals,
+/// then each size's own table ([`markdown`]).
+pub fn sweep_markdown(sizes: &[AtSize]) -> String {
+    let mut s = String::from("| particles | steps | code | procs/threads | steps/s (median) | particle-steps/s | ns per particle-step | verdem best / this | peak RSS per particle (bytes) |\n|---|---|---|---|---|---|---|---|---|\n");
+    for at in sizes {
+        let best = fastest(&at.measured, |c| {
+            matches!(c, Config::Verdem { copies: 1, .. })
+        })
+        .map_or(f64::NAN, Measured::median);
+        for (x, rss) in at.measured.iter().zip(&at.peak_rss) {
+            let (code, n) = x.config.label();
+            let memory = rss.map_or("–".to_string(), |b| {
+                format!("{:.0}", b / at.particles as f64)
+            });
+            s.push_str(&format!(
+                "| {} | {} | {code} | {n} | {:.1} | {:.3e} | {:.2} | {:.2} | {memory} |\n",
+                at.particles,
+                at.steps,
+                x.median(),
+                x.median() * at.particles as f64,
+                ns_per_particle_step(x.median(), at.particles),
+                best / x.median()
+            ));
+        }
+    }
+    s.push_str("\nGoals (medians over the rounds of ratios within a round, 95 % intervals of the median; a goal is met when all of its interval is):\n");
+    for at in sizes {
+        let verdem = fastest(&at.measured, |c| {
+            matches!(c, Config::Verdem { copies: 1, .. })
+        });
+        let peer = fastest(&at.measured, |c| matches!(c, Config::Peer { .. }));
+        if let (Some(v), Some(p)) = (verdem, peer) {
+            let (vc, vn) = v.config.label();
+            let (pc, pn) = p.config.label();
+            let quantity = format!(
+                "{} particles: {vc} {vn} / the fastest peer, {pc} {pn}",
+                at.particles
+            );
+            let verdict = goal_verdict(&quantity, &paired_ratios(p, v), PEER_GOAL);
+            s.push_str(&format!(
+                "- {quantity}: {:.2}; goal ≥ {PEER_GOAL}: {}\n",
+                verdict.measured,
+                in_words(&verdict)
+            ));
+        }
+    }
+    let threads: Vec<usize> = sizes
+        .first()
+        .map(|at| {
+            at.measured
+                .iter()
+                .filter_map(|x| match x.config {
+                    Config::Verdem {
+                        threads, copies: 1, ..
+                    } => Some(threads),
+                    _ => None,
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if sizes.len() > 1 {
+        for t in threads {
+            let rows: Vec<(&Measured, usize)> = sizes
+                .iter()
+                .filter_map(|at| verdem_of(&at.measured, t).map(|m| (m, at.particles)))
+                .collect();
+            let rounds = rows.iter().map(|(m, _)| m.rates.len()).min().unwrap_or(0);
+            let spread: Vec<f64> = (0..rounds)
+                .map(|r| {
+                    let cost: Vec<f64> = rows
+                        .iter()
+                        .map(|(m, n)| ns_per_particle_step(m.rates[r], *n))
+                        .collect();
+                    let hi = cost.iter().cloned().fold(0.0, f64::max);
+                    let lo = cost.iter().cloned().fold(f64::INFINITY, f64::min);
+                    hi / lo
+                })
+                .collect();
+            let quantity = format!(
+                "verdem {t} thread(s): cost per particle-step of the costliest size over the cheapest's"
+            );
+            let verdict = limit_verdict(
+                &quantity,
+                &spread,
+                Limit::Below(SPREAD_GOAL),
+                format!("< {SPREAD_GOAL}"),
+            );
+            s.push_str(&format!(
+                "- {quantity}: {:.2}; goal < {SPREAD_GOAL}: {}\n",
+                verdict.measured,
+                in_words(&verdict)
+            ));
+        }
+    }
+    for at in sizes.iter().filter(|at| at.particles >= SCALE_SPEEDUP_FROM) {
+        if let (Some(one), Some(two)) = (verdem_of(&at.measured, 1), verdem_of(&at.measured, 2)) {
+            let quantity = format!("{} particles: verdem 2 threads / 1 thread", at.particles);
+            let verdict = goal_verdict(&quantity, &paired_ratios(one, two), SCALE_SPEEDUP_GOAL);
+            s.push_str(&format!(
+                "- {quantity}: {:.2}; goal ≥ {SCALE_SPEEDUP_GOAL}: {}\n",
+                verdict.measured,
+                in_words(&verdict)
+            ));
+        }
+    }
+    for at in sizes {
+        s.push_str(&format!(
+            "\n## {} particles, {} steps\n\n{}",
+            at.particles,
+            at.steps,
+            markdown(&at.measured, at.particles)
+        ));
+    }
+    s
+}
+
+/// The table as CSV, one record per size and configuration: code, processes/threads, median
+/// steps/s, particle-steps/s, the rounds' steps/s separated by spaces, then particles, steps
+/// per run, ns per particle-step, verdem's best rate over the code's, verdem's 2-thread rate
+/// over its 1-thread rate at that size (median of the ratios within a round), and the peak
+/// resident memory per particle (bytes; empty where not measured). Fields quoted (RFC 4180)
+/// when they hold a comma, a quote or a line break.
+pub fn csv(sizes: &[AtSize]) -> String {
     let mut w = ::csv::Writer::from_writer(Vec::new());
     let fail = "a CSV table is written to memory";
     w.write_record([
@@ -395,21 +721,139 @@ pub fn csv(m: &[Measured], particles: usize) -> String {
         "median_steps_per_s",
         "particle_steps_per_s",
         "rounds",
+        "particles",
+        "steps",
+        "ns_per_particle_step",
+        "verdem_best_over_this",
+        "verdem_2_over_1_threads",
+        "peak_rss_bytes_per_particle",
     ])
     .expect(fail);
-    for x in m {
-        let (code, n) = x.config.label();
-        let rounds: Vec<String> = x.rates.iter().map(|r| format!("{r:.1}")).collect();
-        w.write_record([
-            code,
-            n,
-            format!("{:.1}", x.median()),
-            format!("{:.1}", x.median() * particles as f64),
-            rounds.join(" "),
-        ])
-        .expect(fail);
+    for at in sizes {
+        let n = at.particles;
+        let best = fastest(&at.measured, |c| {
+            matches!(c, Config::Verdem { copies: 1, .. })
+        })
+        .map_or(f64::NAN, Measured::median);
+        let two_over_one = match (verdem_of(&at.measured, 1), verdem_of(&at.measured, 2)) {
+            (Some(one), Some(two)) => format!("{:.3}", median(&paired_ratios(one, two))),
+            _ => String::new(),
+        };
+        for (x, rss) in at.measured.iter().zip(&at.peak_rss) {
+            let (code, procs) = x.config.label();
+            let rounds: Vec<String> = x.rates.iter().map(|r| format!("{r:.1}")).collect();
+            w.write_record([
+                code,
+                procs,
+                format!("{:.1}", x.median()),
+                format!("{:.1}", x.median() * n as f64),
+                rounds.join(" "),
+                n.to_string(),
+                at.steps.to_string(),
+                format!("{:.3}", ns_per_particle_step(x.median(), n)),
+                if best.is_nan() {
+                    String::new()
+                } else {
+                    format!("{:.3}", best / x.median())
+                },
+                two_over_one.clone(),
+                rss.map_or(String::new(), |b| format!("{:.0}", b / n as f64)),
+            ])
+            .expect(fail);
+        }
     }
     String::from_utf8(w.into_inner().expect(fail)).expect("CSV of UTF-8 fields")
+}
+
+/// Draws the cost per particle-step (ns) against the particles, both on log axes, one line per
+/// code and process count (verdem's ceiling rows left out), into the PNG `path`.
+pub fn cost_png(sizes: &[AtSize], path: &Path) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    crate::analysis::cg::plot::register_font()?;
+    let Some(first) = sizes.first() else {
+        anyhow::bail!("{}: no sizes to plot", path.display());
+    };
+    let lines: Vec<(String, Vec<(f64, f64)>)> = (0..first.measured.len())
+        .filter(|&k| processes(&first.measured[k].config).is_some())
+        .map(|k| {
+            let (code, n) = first.measured[k].config.label();
+            let points = sizes
+                .iter()
+                .map(|at| {
+                    let m = &at.measured[k];
+                    (
+                        at.particles as f64,
+                        ns_per_particle_step(m.median(), at.particles),
+                    )
+                })
+                .filter(|(_, c)| c.is_finite() && *c > 0.0)
+                .collect();
+            (format!("{code}, {n}"), points)
+        })
+        .collect();
+    let all = || lines.iter().flat_map(|(_, p)| p.iter());
+    let (nlo, nhi) = all().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
+        (lo.min(p.0), hi.max(p.0))
+    });
+    let (clo, chi) = all().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
+        (lo.min(p.1), hi.max(p.1))
+    });
+    if !(nlo.is_finite() && clo.is_finite()) {
+        anyhow::bail!("{}: no measured rate to plot", path.display());
+    }
+    let colours = [
+        BLUE,
+        RED,
+        GREEN,
+        MAGENTA,
+        BLACK,
+        CYAN,
+        RGBColor(230, 140, 0),
+    ];
+    let tmp = path.with_extension("part.png");
+    let drawn = (|| -> anyhow::Result<Vec<u8>> {
+        {
+            let root = BitMapBackend::new(&tmp, (900, 600)).into_drawing_area();
+            root.fill(&WHITE)?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(
+                    "cost per particle-step against system size",
+                    ("sans-serif", 20),
+                )
+                .margin(12)
+                .x_label_area_size(44)
+                .y_label_area_size(64)
+                .build_cartesian_2d(
+                    (nlo / 1.5..nhi * 1.5).log_scale(),
+                    (clo / 1.5..chi * 1.5).log_scale(),
+                )?;
+            chart
+                .configure_mesh()
+                .x_desc("particles")
+                .y_desc("ns per particle-step")
+                .label_style(("sans-serif", 13))
+                .draw()?;
+            for ((label, points), colour) in lines.iter().zip(colours.iter().cycle()) {
+                chart
+                    .draw_series(LineSeries::new(points.iter().copied(), colour))?
+                    .label(label.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 13))
+                .draw()?;
+            root.present()?;
+        }
+        std::fs::read(&tmp).with_context(|| format!("{}: cannot read back", tmp.display()))
+    })();
+    // the scratch file goes whatever happened; a failure to remove it is not the error to report
+    let _ = std::fs::remove_file(&tmp);
+    crate::io::atomic::write(path, &drawn?)
+        .with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// The first lines of `bench.md`: what was timed (`steps` steps of `case` from the state file
@@ -461,11 +905,17 @@ mod tests {
             np: 2,
         };
         let m = [measured(1, 2, &[100.0, 110.05]), peer];
+        let mut at = AtSize::without_memory(10, 500, m.to_vec());
+        at.peak_rss[1] = Some(2048.0);
+        // no verdem row of one copy: no "verdem best", no 2/1 ratio; ns = 1e9 / (105.025 × 10)
+        // and 1e9 / (2 × 10); 2048 bytes over 10 particles
         assert_eq!(
-            csv(&m, 10),
-            "code,procs,median_steps_per_s,particle_steps_per_s,rounds\n\
-             2 independent verdem runs at once (summed),2×1,105.0,1050.2,100.0 110.0\n\
-             lammps,2,2.0,20.0,1.0 3.0\n"
+            csv(&[at]),
+            "code,procs,median_steps_per_s,particle_steps_per_s,rounds,particles,steps,\
+             ns_per_particle_step,verdem_best_over_this,verdem_2_over_1_threads,\
+             peak_rss_bytes_per_particle\n\
+             2 independent verdem runs at once (summed),2×1,105.0,1050.2,100.0 110.0,10,500,952154.249,,,\n\
+             lammps,2,2.0,20.0,1.0 3.0,10,500,50000000.000,,,205\n"
         );
     }
 
@@ -586,5 +1036,101 @@ mod tests {
             "{md}"
         );
         assert!(!md.contains("share nothing"), "{md}");
+    }
+
+    /// A configuration's measurement with `rates`.
+    fn of(config: Config, rates: &[f64]) -> Measured {
+        Measured {
+            config,
+            rates: rates.to_vec(),
+            copy_rates: Vec::new(),
+            stages: None,
+        }
+    }
+
+    /// Two sizes, six rounds each: verdem on 1 and 2 threads and LAMMPS on 2 ranks.
+    fn two_sizes() -> Vec<AtSize> {
+        let lammps = || Config::Peer {
+            peer: crate::peers::by_name("lammps").unwrap(),
+            np: 2,
+        };
+        let size = |n: usize, one: f64, two: f64, peer: f64| {
+            AtSize::without_memory(
+                n,
+                100,
+                vec![
+                    measured(1, 1, &[one; 6]),
+                    measured(2, 1, &[two; 6]),
+                    of(lammps(), &[peer; 6]),
+                ],
+            )
+        };
+        vec![
+            size(3480, 1000.0, 1800.0, 300.0),
+            size(55680, 50.0, 64.0, 20.0),
+        ]
+    }
+
+    #[test]
+    fn a_sweep_judges_the_peers_the_spread_across_sizes_and_the_large_sizes_threads() {
+        let md = sweep_markdown(&two_sizes());
+        // 1800 / 300 and 64 / 20
+        assert!(md.contains("- 3480 particles: verdem (deterministic) 2 / the fastest peer, lammps 2: 6.00; goal ≥ 5: met (95 % interval of the median 6.000–6.000)"), "{md}");
+        assert!(md.contains("- 55680 particles: verdem (deterministic) 2 / the fastest peer, lammps 2: 3.20; goal ≥ 5: not met"), "{md}");
+        // 1 thread: 1e9/(50·55680) = 359.2 ns over 1e9/(1000·3480) = 287.4 ns
+        assert!(md.contains("verdem 1 thread(s): cost per particle-step of the costliest size over the cheapest's: 1.25; goal < 1.5: met"), "{md}");
+        // 2 threads: 1e9/(64·55680) = 280.6 ns over 1e9/(1800·3480) = 159.6 ns
+        assert!(md.contains("verdem 2 thread(s): cost per particle-step of the costliest size over the cheapest's: 1.76; goal < 1.5: not met"), "{md}");
+        // 2/1 judged from 55680 particles on only: 64/50
+        assert!(
+            md.contains(
+                "- 55680 particles: verdem 2 threads / 1 thread: 1.28; goal ≥ 1.8: not met"
+            ),
+            "{md}"
+        );
+        assert!(
+            !md.contains("- 3480 particles: verdem 2 threads / 1 thread"),
+            "{md}"
+        );
+        // the summary row: 1e9 / (20 · 55680) ns and 64 / 20
+        assert!(
+            md.contains("| 55680 | 100 | lammps | 2 | 20.0 | 1.114e6 | 897.99 | 3.20 | – |"),
+            "{md}"
+        );
+        assert!(md.contains("## 3480 particles, 100 steps"), "{md}");
+    }
+
+    #[test]
+    fn the_csv_gives_each_size_its_rows_and_its_two_thread_ratio() {
+        let mut sizes = two_sizes();
+        sizes[1].peak_rss[0] = Some(55680.0 * 300.0);
+        let csv = csv(&sizes);
+        let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+        assert_eq!(rows.len(), 7);
+        assert!(rows.iter().all(|r| r.len() == 11), "{csv}");
+        assert_eq!(rows[4][..2], ["verdem (deterministic)", "1"]);
+        assert_eq!(
+            rows[4][5..],
+            ["55680", "100", "359.195", "1.280", "1.280", "300"]
+        );
+        assert_eq!(rows[1][9], "1.800");
+    }
+
+    #[test]
+    fn the_cost_plot_is_a_png_of_the_stated_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cost.png");
+        cost_png(&two_sizes(), &path).unwrap();
+        let decoder = png::Decoder::new(std::fs::File::open(&path).unwrap());
+        let info = decoder.read_info().unwrap().info().clone();
+        assert_eq!((info.width, info.height), (900, 600));
+        assert!(!dir.path().join("cost.part.png").exists());
+    }
+
+    #[test]
+    fn steps_per_size_keep_the_particle_steps() {
+        assert_eq!(steps_for(69_600_000, 3480), 20_000);
+        assert_eq!(steps_for(69_600_000, 222_720), 313);
+        assert_eq!(steps_for(10, 3480), 1);
     }
 }

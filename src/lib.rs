@@ -21,6 +21,7 @@ pub mod stability;
 pub mod state;
 pub mod step;
 pub mod team;
+pub mod tile;
 pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.

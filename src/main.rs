@@ -56,6 +56,9 @@ enum Command {
     Ensemble(cli::ensemble::Args),
     /// Print the SHA-256 of the full state after N steps (no files written).
     Hash(cli::hash::Args),
+    /// Tile a bumpy-shear case and its state nx × ny in x–y (same gap, walls tiled with the
+    /// cell): writes OUT/NAME_NXxNY.toml and its state OUT/NAME_NXxNY.data.
+    Tile(cli::tile::Args),
     /// Convert a MercuryCG series (verdem's or a peer's) into ParaView files: NAME.NNNN.vtu per
     /// save (particles and contact lines) and the NAME.pvd time series.
     Vtk(cli::vtk::Args),
@@ -74,6 +77,7 @@ fn main() {
         Command::Kinematics(a) => cli::kinematics::exec(a),
         Command::Ensemble(a) => cli::ensemble::exec(a),
         Command::Hash(a) => cli::hash::exec(a),
+        Command::Tile(a) => cli::tile::exec(a),
         Command::Vtk(a) => cli::vtk::exec(a),
         Command::Extremes(a) => cli::extremes::exec(a),
     };

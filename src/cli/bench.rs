@@ -1,10 +1,11 @@
 //! `verdem bench`: time verdem against the installed peers on the same case and state, and
-//! write the table.
+//! write the table; with `--scale`, the same at several system sizes (the case tiled n × n).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
-use anyhow::Context;
-use verdem::bench::{self, Config};
+use anyhow::{bail, Context};
+use verdem::bench::{self, AtSize, Config, Size};
 use verdem::case::Case;
 use verdem::io::atomic;
 use verdem::scene;
@@ -12,22 +13,42 @@ use verdem::scene;
 use super::args::count;
 use super::Finished;
 
+/// The state a single-size bench starts from: MercuryDPM's developing state.
+const DEVELOPING: &str = "data/states/mercury_t143.85.data";
+
+/// The state a sweep tiles: verdem's full run's final state, so that every code starts steady.
+const STEADY: &str = "golden/full_run/shear_flow.final.data";
+
+/// The peers a sweep times unless --peers names others (Yade and Kratos, far slower, when
+/// named).
+const SWEPT_PEERS: &str = "lammps,liggghts";
+
 #[derive(clap::Args)]
 pub struct Args {
     /// Case file (default: cases/shear_flow_quick.toml).
     case: Option<PathBuf>,
-    /// State to start from (default: MercuryDPM's developed state).
-    #[arg(long, default_value = "data/states/mercury_t143.85.data")]
-    from: PathBuf,
+    /// State to start from (default: MercuryDPM's developed state data/states/mercury_t143.85.data;
+    /// with --scale, the one tiled: the full run's final state golden/full_run/shear_flow.final.data).
+    #[arg(long)]
+    from: Option<PathBuf>,
     #[arg(long, default_value_t = 20_000, value_parser = count::<u64>)]
     steps: u64,
+    /// Sweep system sizes: the case and its state tiled n × n in x–y for each n listed
+    /// (1,2,4,8: 3480 to 222720 spheres of the benchmark), each timed with every configuration.
+    #[arg(long, value_delimiter = ',', value_parser = count::<usize>, conflicts_with = "steps")]
+    scale: Vec<usize>,
+    /// With --scale: particle-steps of each run (steps at a size = this / its particles, so
+    /// that every run takes about the same time).
+    #[arg(long, default_value_t = 69_600_000, value_parser = count::<u64>)]
+    particle_steps: u64,
     /// verdem thread counts.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     threads: Vec<usize>,
     /// Peers to run, comma-separated (`verdem peers` lists them; none: --peers ''). The default
-    /// leaves out Kratos DEM, about 100 times slower than LAMMPS: name it, with fewer --steps.
-    #[arg(long, default_value_t = verdem::peers::bench_names())]
-    peers: String,
+    /// leaves out Kratos DEM, about 100 times slower than LAMMPS: name it, with fewer --steps;
+    /// with --scale it is lammps,liggghts (name Yade and Kratos to sweep them too).
+    #[arg(long)]
+    peers: Option<String>,
     /// MPI ranks (Yade: OpenMP threads) for the peers.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     np: Vec<usize>,
@@ -40,16 +61,26 @@ pub struct Args {
     /// as a team's threads do.
     #[arg(long)]
     no_ceiling: bool,
-    /// Where the table (bench.md, bench.csv) and the peers' inputs go.
+    /// Where the table (bench.md, bench.csv; with --scale also bench.png) and the peers' inputs
+    /// go.
     #[arg(long, default_value = "out/bench")]
     out: PathBuf,
+    /// Run one configuration (`verdem:THREADS` or `PEER:NP`) once and print its peak resident
+    /// memory: the child process a sweep measures memory with.
+    #[arg(long, hide = true)]
+    probe: Option<String>,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(
-        &a.case
-            .unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml")),
-    )?;
+    let case_path = a
+        .case
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml"));
+    let case = Case::load(&case_path)?;
+    if let Some(probe) = &a.probe {
+        let from = a.from.clone().unwrap_or_else(|| DEVELOPING.into());
+        return run_probe(&case, &from, a.steps, probe, &a.out);
+    }
     for warning in a
         .threads
         .iter()
@@ -73,18 +104,158 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             lockstep,
         }));
     }
-    for peer in verdem::peers::parse_list(&a.peers).context("--peers")? {
+    let peers = a.peers.clone().unwrap_or_else(|| {
+        if a.scale.is_empty() {
+            verdem::peers::bench_names()
+        } else {
+            SWEPT_PEERS.to_string()
+        }
+    });
+    for peer in verdem::peers::parse_list(&peers).context("--peers")? {
         configs.extend(a.np.iter().map(|&n| Config::Peer { peer, np: n }));
     }
-    let measured = bench::run(&case, &a.from, a.steps, &configs, a.rounds, &a.out)?;
-    let particles = scene::build(&case, Some(&a.from))?.particles.len();
-    let md = bench::header(&case.name, &a.from, a.steps, a.rounds)
+    if !a.scale.is_empty() {
+        return sweep(&a, &case_path, &configs);
+    }
+    let from = a.from.clone().unwrap_or_else(|| DEVELOPING.into());
+    let measured = bench::run(&case, &from, a.steps, &configs, a.rounds, &a.out)?;
+    let particles = scene::build(&case, Some(&from))?.particles.len();
+    let md = bench::header(&case.name, &from, a.steps, a.rounds)
         + &bench::markdown(&measured, particles);
     print!("{md}");
     atomic::write(&a.out.join("bench.md"), md.as_bytes())?;
-    atomic::write(
-        &a.out.join("bench.csv"),
-        bench::csv(&measured, particles).as_bytes(),
-    )?;
+    let at = AtSize::without_memory(particles, a.steps, measured);
+    atomic::write(&a.out.join("bench.csv"), bench::csv(&[at]).as_bytes())?;
+    Ok(Finished::Done)
+}
+
+/// `--scale`: tiles the case for each size into OUT/NxN, times every configuration at every
+/// size, measures each code's peak memory in a child process, and writes the tables and the
+/// plot.
+fn sweep(a: &Args, case_path: &Path, configs: &[Config]) -> anyhow::Result<Finished> {
+    let from = a.from.clone().unwrap_or_else(|| STEADY.into());
+    let mut sizes = Vec::new();
+    for &n in &a.scale {
+        let work = a.out.join(format!("{n}x{n}"));
+        let (case_file, state) = verdem::tile::write(case_path, &from, n, n, &work)?;
+        let case = Case::load(&case_file)?;
+        let particles = scene::build(&case, Some(&state))?.particles.len();
+        sizes.push(Size {
+            case,
+            state,
+            particles,
+            steps: bench::steps_for(a.particle_steps, particles),
+            work,
+        });
+    }
+    let mut measured = bench::sweep(&sizes, configs, a.rounds)?;
+    for (z, at) in sizes.iter().zip(measured.iter_mut()) {
+        for (k, c) in configs.iter().enumerate() {
+            if let Some(procs) = bench::processes(c) {
+                at.peak_rss[k] = Some(procs as f64 * probe_memory(z, c)?);
+            }
+        }
+    }
+    let md = sweep_header(a, case_path, &from, &sizes) + &bench::sweep_markdown(&measured);
+    print!("{md}");
+    atomic::write(&a.out.join("bench.md"), md.as_bytes())?;
+    atomic::write(&a.out.join("bench.csv"), bench::csv(&measured).as_bytes())?;
+    bench::cost_png(&measured, &a.out.join("bench.png"))?;
+    Ok(Finished::Done)
+}
+
+/// What a sweep timed, how, and on what.
+fn sweep_header(a: &Args, case_path: &Path, from: &Path, sizes: &[Size]) -> String {
+    let list: Vec<String> = a
+        .scale
+        .iter()
+        .zip(sizes)
+        .map(|(n, z)| format!("{n}×{n}: {} particles, {} steps", z.particles, z.steps))
+        .collect();
+    format!(
+        "{} tiled n × n in x–y from {} ({}); each run about {} particle-steps; {} alternating rounds (each round every size in turn, each size every configuration in turn); {} cores ({}); no file output in the timed region.\n\
+Peak resident memory: one more run of each configuration at each size ({} steps at most) in a child process, its peak resident set (verdem: the child's own, VmHWM, state reading and scene included; a peer: the largest of mpirun and its ranks from getrusage, times the ranks, as the kernel does not sum them), over the particles.\n\n",
+        case_path.display(),
+        from.display(),
+        list.join("; "),
+        a.particle_steps,
+        a.rounds,
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0),
+        bench::cpu_model(),
+        PROBE_STEPS
+    )
+}
+
+/// The most steps a memory probe runs (the peak is reached at set-up and the first rebuilds).
+const PROBE_STEPS: u64 = 200;
+
+/// The peak resident memory (bytes) of one process of configuration `c` run at size `z`, from a
+/// child `verdem bench --probe` (a peer's probe reads the peer's state file written here, so
+/// that the probe itself stays small: its children count its peak).
+fn probe_memory(z: &Size, c: &Config) -> anyhow::Result<f64> {
+    let dir = |probe: &str| z.work.join(format!("probe-{}", probe.replace(':', "-")));
+    let (probe, from) = match c {
+        Config::Verdem { threads, .. } => (format!("verdem:{threads}"), z.state.clone()),
+        Config::Peer { peer, np } => {
+            let probe = format!("{}:{np}", peer.name());
+            let data = bench::write_peer_state(&z.case, &z.state, *peer, &z.work, "probe")?;
+            (probe, data)
+        }
+    };
+    let exe = std::env::current_exe().context("the path of the verdem program")?;
+    let out = Command::new(&exe)
+        .arg("bench")
+        .arg(&z.case.path)
+        .arg("--from")
+        .arg(&from)
+        .args(["--steps", &z.steps.min(PROBE_STEPS).to_string()])
+        .args(["--probe", &probe])
+        .arg("--out")
+        .arg(dir(&probe))
+        .output()
+        .with_context(|| format!("cannot start {}", exe.display()))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        bail!(
+            "the memory probe {probe} at {} particles failed: {}",
+            z.particles,
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+    text.lines()
+        .find_map(|l| l.strip_prefix("peak_rss_bytes "))
+        .and_then(|v| v.trim().parse().ok())
+        .with_context(|| format!("the memory probe {probe} printed no peak_rss_bytes: {text}"))
+}
+
+/// `--probe`: runs one configuration once and prints `peak_rss_bytes B`: verdem from the state
+/// `from`, its own peak ([`bench::own_peak_rss`]); a peer from its own state file `from`, its
+/// largest process's peak ([`bench::children_peak_rss`]).
+fn run_probe(
+    case: &Case,
+    from: &Path,
+    steps: u64,
+    probe: &str,
+    out: &Path,
+) -> anyhow::Result<Finished> {
+    let (code, n) = probe
+        .split_once(':')
+        .with_context(|| format!("--probe {probe}: CODE:N expected"))?;
+    let n: usize = count(n).map_err(anyhow::Error::msg)?;
+    let bytes = if code == "verdem" {
+        let config = Config::Verdem {
+            threads: n,
+            copies: 1,
+            lockstep: false,
+        };
+        bench::run(case, from, steps, &[config], 1, out)?;
+        bench::own_peak_rss()
+    } else {
+        let peer = verdem::peers::by_name(code)?;
+        bench::run_peer(case, peer, n, from, steps, out)?;
+        bench::children_peak_rss()
+    };
+    let bytes = bytes.context("no peak resident memory (/proc/self/status, getrusage)")?;
+    println!("peak_rss_bytes {bytes:.0}");
     Ok(Finished::Done)
 }
