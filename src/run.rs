@@ -259,6 +259,11 @@ pub fn run_observed(
         )?),
     };
     let bar = progress_bar(opts, start_step);
+    // The ledgers' reading at the last save; a run resumed between saves has none until its
+    // first save.
+    let mut last_reading =
+        (resumed && engine.state().forces_ready && start_step.is_multiple_of(opts.save_every))
+            .then(|| engine.ledger());
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
@@ -268,7 +273,10 @@ pub fn run_observed(
             if !engine.state().forces_ready {
                 engine.advance(0).map_err(|f| kept.stopped(f))?;
             }
-            let save = write_save(engine, opts, &diag, vtk_series.as_mut())
+            let reading = engine.ledger();
+            let ledger = last_reading.map(|before| reading.since(&before));
+            last_reading = Some(reading);
+            let save = write_save(engine, opts, &diag, vtk_series.as_mut(), ledger)
                 .map_err(|e| kept.not_written(e, &opts.out_dir))?;
             kept.save = Some(save);
             saves += 1;
@@ -384,13 +392,15 @@ impl Kept {
 }
 
 /// Writes the save of the current step (`.data`, `.fstat`, the `.vtu` when asked, then its
-/// diagnostics row); returns the path of its `.data` file. A save that cannot be written whole
-/// is removed, so the folder holds whole saves only.
+/// diagnostics row, with the ledgers `ledger` since the previous save); returns the path of its
+/// `.data` file. A save that cannot be written whole is removed, so the folder holds whole
+/// saves only.
 fn write_save(
     engine: &dyn Engine,
     opts: &RunOptions,
     diag: &Path,
     vtk_series: Option<&mut vtk::Series>,
+    ledger: Option<crate::step::LedgerRow>,
 ) -> anyhow::Result<PathBuf> {
     let core = &engine.snapshot();
     let k = core.step / opts.save_every;
@@ -406,7 +416,11 @@ fn write_save(
         if let Some(series) = vtk_series {
             replaced.push(series.write(k, &vtk::Frame::of_snapshot(core))?);
         }
-        atomic::append(diag, Diagnostics::of(core, k).csv_row().as_bytes())
+        let row = Diagnostics {
+            ledger,
+            ..Diagnostics::of(core, k)
+        };
+        atomic::append(diag, row.csv_row().as_bytes())
     })();
     if let Err(e) = written {
         for p in &replaced {

@@ -100,9 +100,18 @@ fn a_short_run_from_the_final_state_matches_the_steady_profiles_and_the_peers() 
             );
         }
     }
+    // The stored run's table predates the ledger columns: the columns it has are compared.
     let diagnostics = |path: &std::path::Path| -> Vec<String> {
         let text = std::fs::read_to_string(path).unwrap();
-        text.lines().map(str::to_string).collect()
+        let stored_columns = 10;
+        text.lines()
+            .map(|l| {
+                l.split(',')
+                    .take(stored_columns)
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .collect()
     };
     let ours = diagnostics(&dir.path().join("s.diagnostics.csv"));
     let stored = diagnostics(&peers("verdem.diagnostics.csv"));

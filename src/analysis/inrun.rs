@@ -289,6 +289,7 @@ impl Inrun {
                     [self.wall[b][0] / n, self.wall[b][1] / n]
                 })
                 .collect(),
+            wall_force_every_step: false,
             domain: self.domain.clone(),
             free: self.free,
             free_volume: self.free_volume,

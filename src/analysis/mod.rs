@@ -8,6 +8,7 @@
 pub mod cg;
 pub mod ensemble;
 pub mod inrun;
+pub mod ledger;
 pub mod particles;
 pub mod stats;
 pub mod tradeoff;

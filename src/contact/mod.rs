@@ -125,6 +125,21 @@ impl PairInput {
     }
 }
 
+/// The energy a contact's dissipative parts took from its particles over one step (energy
+/// units, positive when taken), at the velocities the law saw: the energy ledger's dissipation,
+/// split by the part that took it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Dissipated {
+    /// The normal dashpot: the part of the normal force that is not elastic, against the normal
+    /// relative velocity.
+    pub normal: f64,
+    /// The tangential dashpot: the part of the tangential force the spring does not give,
+    /// against the slip.
+    pub tangential: f64,
+    /// The Coulomb slider: the elastic energy the spring lost when the cap reset it.
+    pub slide: f64,
+}
+
 /// A complete contact law: the force of one contact from its kinematics and its history.
 pub trait ContactLaw: Send + Sync {
     /// False when the law can never produce a tangential force: the solver then skips torques
@@ -150,6 +165,25 @@ pub trait ContactLaw: Send + Sync {
     fn normal_energy(&self, delta: f64) -> f64 {
         self.stored_energy(delta, &Self::History::default())
     }
+
+    /// Whether [`ContactLaw::evaluate_dissipating`] reports the dissipation split by part. False
+    /// by default: the energy ledger then says the dissipation is not split and leaves its
+    /// residual unmeasured, rather than take a zero for a closed balance.
+    const SPLITS_DISSIPATION: bool = false;
+
+    /// [`ContactLaw::evaluate`], and the energy the contact's dissipative parts took over the
+    /// step ([`Dissipated`]; meaningful only with [`ContactLaw::SPLITS_DISSIPATION`]). The
+    /// force must be bit for bit that of [`ContactLaw::evaluate`]. By default that force and
+    /// nothing split.
+    #[inline(always)]
+    fn evaluate_dissipating(
+        &self,
+        k: &PairKinematics,
+        history: &mut Self::History,
+        dt: f64,
+    ) -> (PairForce, Dissipated) {
+        (self.evaluate(k, history, dt), Dissipated::default())
+    }
 }
 
 /// A normal model and a tangential model composed into a contact law.
@@ -168,32 +202,7 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
 
     #[inline(always)]
     fn evaluate(&self, k: &PairKinematics, xi: &mut T::History, dt: f64) -> PairForce {
-        let fn_signed = self.normal.force(k.delta, k.vn);
-        if T::ACTIVE {
-            let ft = self.tangential.force(k, fn_signed, xi, dt);
-            let f = fn_signed * k.n + ft;
-            // Lever arms of the torques: to the contact point in the middle of the overlap
-            // (MercuryDPM), or full radii along n where the convention's source does so.
-            let (arm_p, arm_i) = if T::FULL_RADIUS_LEVER {
-                (-k.rad_p * k.n, k.rad_i * k.n)
-            } else {
-                (k.arm_p, k.arm_i)
-            };
-            PairForce {
-                f,
-                fn_signed,
-                // Torque about each centre: (c − x) × F (MercuryDPM BaseInteraction).
-                torque_p: arm_p.cross(&f),
-                torque_i: arm_i.cross(&(-f)),
-            }
-        } else {
-            PairForce {
-                f: fn_signed * k.n,
-                fn_signed,
-                torque_p: Vec3::zeros(),
-                torque_i: Vec3::zeros(),
-            }
-        }
+        self.evaluate_dissipating(k, xi, dt).0
     }
 
     fn stored_energy(&self, delta: f64, xi: &T::History) -> f64 {
@@ -202,6 +211,55 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
 
     fn normal_energy(&self, delta: f64) -> f64 {
         self.normal.stored_energy(delta)
+    }
+
+    const SPLITS_DISSIPATION: bool = N::SPLITS_DISSIPATION && T::SPLITS_DISSIPATION;
+
+    #[inline(always)]
+    fn evaluate_dissipating(
+        &self,
+        k: &PairKinematics,
+        xi: &mut T::History,
+        dt: f64,
+    ) -> (PairForce, Dissipated) {
+        let fn_signed = self.normal.force(k.delta, k.vn);
+        let normal = self.normal.dissipated(k.delta, k.vn, fn_signed, dt);
+        if T::ACTIVE {
+            let (ft, [tangential, slide]) = self.tangential.force_dissipating(k, fn_signed, xi, dt);
+            let f = fn_signed * k.n + ft;
+            // Lever arms of the torques: to the contact point in the middle of the overlap
+            // (MercuryDPM), or full radii along n where the convention's source does so.
+            let (arm_p, arm_i) = if T::FULL_RADIUS_LEVER {
+                (-k.rad_p * k.n, k.rad_i * k.n)
+            } else {
+                (k.arm_p, k.arm_i)
+            };
+            let force = PairForce {
+                f,
+                fn_signed,
+                // Torque about each centre: (c − x) × F (MercuryDPM BaseInteraction).
+                torque_p: arm_p.cross(&f),
+                torque_i: arm_i.cross(&(-f)),
+            };
+            let lost = Dissipated {
+                normal,
+                tangential,
+                slide,
+            };
+            (force, lost)
+        } else {
+            let force = PairForce {
+                f: fn_signed * k.n,
+                fn_signed,
+                torque_p: Vec3::zeros(),
+                torque_i: Vec3::zeros(),
+            };
+            let lost = Dissipated {
+                normal,
+                ..Dissipated::default()
+            };
+            (force, lost)
+        }
     }
 }
 

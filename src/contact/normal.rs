@@ -11,6 +11,17 @@ pub trait NormalModel: Send + Sync {
     /// Elastic energy stored at overlap `delta` (length, > 0), in energy units: what the spring
     /// can give back; the dashpot stores none.
     fn stored_energy(&self, delta: f64) -> f64;
+
+    /// Whether [`NormalModel::dissipated`] is implemented (false by default: the law's
+    /// dissipation is then not split).
+    const SPLITS_DISSIPATION: bool = false;
+
+    /// The energy (energy units) the non-elastic part of the force `fn_signed` (this model's at
+    /// `delta`, `vn`) takes from the pair over a step `dt` (time) at the normal relative
+    /// velocity `vn`: −(fn − fn_elastic)·vn·dt. Zero by default (not split).
+    fn dissipated(&self, _delta: f64, _vn: f64, _fn_signed: f64, _dt: f64) -> f64 {
+        0.0
+    }
 }
 
 /// Linear spring with an absolute dashpot, fn = kn·δ − γn·vn (force units; γn in mass/time,
@@ -33,6 +44,14 @@ impl NormalModel for LinearSpringDashpot {
     fn stored_energy(&self, delta: f64) -> f64 {
         0.5 * self.kn * delta * delta
     }
+
+    const SPLITS_DISSIPATION: bool = true;
+
+    /// γn·vn²·dt: the dashpot's force −γn·vn against the velocity vn.
+    #[inline(always)]
+    fn dissipated(&self, _delta: f64, vn: f64, _fn_signed: f64, dt: f64) -> f64 {
+        self.gamman * vn * vn * dt
+    }
 }
 
 /// Wraps a normal model and clips its attractive part: max(fn, 0).
@@ -49,6 +68,21 @@ impl<N: NormalModel> NormalModel for Clipped<N> {
     /// while the spring itself still holds ½·kn·δ².
     fn stored_energy(&self, delta: f64) -> f64 {
         self.0.stored_energy(delta)
+    }
+
+    const SPLITS_DISSIPATION: bool = N::SPLITS_DISSIPATION;
+
+    /// The wrapped model's while the force is not clipped; clipped to zero, the non-elastic part
+    /// is minus the elastic force, taken as the wrapped force at vn = 0 (a dashpot gives no
+    /// force at rest), so the energy taken is fn_elastic·vn·dt.
+    #[inline(always)]
+    fn dissipated(&self, delta: f64, vn: f64, _fn_signed: f64, dt: f64) -> f64 {
+        let unclipped = self.0.force(delta, vn);
+        if unclipped >= 0.0 {
+            self.0.dissipated(delta, vn, unclipped, dt)
+        } else {
+            self.0.force(delta, 0.0) * vn * dt
+        }
     }
 }
 

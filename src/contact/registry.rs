@@ -152,6 +152,55 @@ pub fn listing() -> impl Iterator<Item = (&'static str, &'static str)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::tangential::test_kinematics;
+    use crate::Vec3;
+
+    /// The work a contact's tangential force takes from a steady slip over `steps` steps, less
+    /// what its spring holds at the end and what its dashpot and slider report, relative to the
+    /// work.
+    struct Unaccounted {
+        steps: usize,
+    }
+
+    impl TangentialVisitor for Unaccounted {
+        type Output = f64;
+        fn visit<T: TangentialModel + Clone + 'static>(self, model: T) -> f64 {
+            // P slides along x over I at rest, the normal along z fixed: no frame turns.
+            let k = test_kinematics(
+                Vec3::new(0.0, 0.0, 0.9999),
+                Vec3::new(0.5, 0.0, 0.0),
+                Vec3::zeros(),
+                Vec3::zeros(),
+            );
+            let (dt, fn_signed) = (1e-4, 10.0);
+            let mut history = T::History::default();
+            let (mut taken, mut reported) = (0.0, 0.0);
+            for _ in 0..self.steps {
+                let (f, [dashpot, slide]) =
+                    model.force_dissipating(&k, fn_signed, &mut history, dt);
+                taken -= f.dot(&k.vt) * dt;
+                reported += dashpot + slide;
+            }
+            (taken - model.stored_energy(&history) - reported) / taken
+        }
+    }
+
+    /// Every convention splits its dissipation so that, over a contact that sticks and then
+    /// slides, the work its force takes is what its spring holds plus what its dashpot and slider
+    /// report, to a step's share of the work (the springs' work and energy telescope up to the
+    /// two ends). Counting the spring energy the cap's reset releases as the slider's would
+    /// leave ½·kt·|slip·dt|² a sliding step unaccounted: 0.7 % of the work here.
+    #[test]
+    fn every_convention_accounts_for_the_work_its_tangential_force_takes() {
+        for t in Tangential::ALL {
+            let missing = t.with_model(1000.0, 5.0, 0.3, Unaccounted { steps: 500 });
+            assert!(
+                missing.abs() < 2e-3,
+                "{}: {missing:e} of the work",
+                t.name()
+            );
+        }
+    }
 
     #[test]
     fn names_are_unique_and_the_full_radius_conventions_do_not_conserve_angular_momentum() {

@@ -16,7 +16,7 @@
 use std::sync::atomic::AtomicBool;
 
 use crate::neighbor::rebuild::{ListState, CLASSES};
-use crate::state::{PairForce, Tally};
+use crate::state::{Motion, PairForce, Tally};
 use crate::team::SharedSlice;
 use crate::Vec3;
 
@@ -31,6 +31,7 @@ pub(super) struct Arrays<H> {
     pub radius: SharedSlice<f64>,
     pub inv_mass: SharedSlice<f64>,
     pub inv_inertia: SharedSlice<f64>,
+    pub motion: SharedSlice<Motion>,
     pub touched: SharedSlice<AtomicBool>,
     pub near_face: SharedSlice<bool>,
     pub quiet: SharedSlice<bool>,
@@ -76,6 +77,7 @@ impl<H> Arrays<H> {
             radius: SharedSlice::of(&mut pt.radius),
             inv_mass: SharedSlice::of(&mut pt.inv_mass),
             inv_inertia: SharedSlice::of(&mut pt.inv_inertia),
+            motion: SharedSlice::of(&mut pt.motion),
             touched: SharedSlice::of(&mut flags.touched),
             near_face: SharedSlice::of(&mut flags.near_face),
             quiet: SharedSlice::of(&mut flags.quiet),

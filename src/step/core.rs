@@ -81,6 +81,8 @@ pub struct Core<H> {
     /// Largest excess of a contact's energy account in the pair passes so far, as a fraction of
     /// what the contact took.
     pub pumped: f64,
+    /// The ledgers' flows over every step run so far ([`super::Engine::ledger`]).
+    pub(super) flows: super::Flows,
     pub(super) work: Workspace,
 }
 
@@ -132,6 +134,7 @@ impl<H: History> Core<H> {
             failure: None,
             deepest: 0.0,
             pumped: 0.0,
+            flows: super::Flows::default(),
             work: Workspace {
                 moved_bound: [0.0; 2],
                 builder,

@@ -4,10 +4,11 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::arrays::Arrays;
+use super::energy::{fixed, Flows};
 use super::guard::Breach;
-use crate::contact::{ContactLaw, PairInput};
+use crate::contact::{ContactLaw, Dissipated, PairInput};
 use crate::neighbor::rebuild::CLASSES;
-use crate::state::{Domain, PairForce, Tally};
+use crate::state::{Domain, Motion, PairForce, Tally};
 use crate::team::SharedSlice;
 use crate::Vec3;
 
@@ -22,6 +23,8 @@ pub(super) struct PairView<'a, L> {
     pub w: SharedSlice<Vec3>,
     pub radius: &'a [f64],
     pub inv_mass: &'a [f64],
+    /// How each particle moves: the wall group of a prescribed one.
+    pub motion: &'a [Motion],
     /// Largest overlap allowed, as a fraction of the smaller radius (the run guard).
     pub overlap: f64,
     /// Largest excess of a contact's energy account allowed, as a fraction of the energy it took
@@ -34,12 +37,14 @@ pub(super) struct PairView<'a, L> {
 /// finite), the largest excess of a contact's energy account as a fraction of the energy it took
 /// (0 when none gave out more than it took; infinite when one gave energy it never took), and the
 /// work the prescribed particles did on the free ones this step, in fixed point
-/// ([`super::energy::fixed`]).
+/// ([`super::energy::fixed`]); and for the ledgers, the contacts' dissipation and the walls'
+/// impulses (`flows.wall_work` is left to the caller, who takes `wall_work`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct Watch {
     pub worst: f64,
     pub pumped: f64,
     pub wall_work: i128,
+    pub flows: Flows,
 }
 
 impl Watch {
@@ -47,16 +52,19 @@ impl Watch {
         self.worst = self.worst.max(other.worst);
         self.pumped = self.pumped.max(other.pumped);
         self.wall_work += other.wall_work;
+        self.flows.add(&other.flows);
     }
 }
 
 /// A pair in contact after its force evaluation, for the run guard: its overlap `delta`
 /// (length) and the power (energy/time) its previous force delivers at the velocities of this
-/// evaluation (`None` for a new contact, not in contact at the evaluation before).
+/// evaluation (`None` for a new contact, not in contact at the evaluation before); for the
+/// energy ledger, what its dissipative parts took over the step.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Touch {
     pub delta: f64,
     pub before: Option<f64>,
+    pub dissipated: Dissipated,
 }
 
 /// A range of pairs and their slots.
@@ -172,7 +180,9 @@ pub(super) unsafe fn pair_range<L: ContactLaw, const PERIODIC: bool>(
     let mut visit = |k: usize, s: &mut PairSlots<'_, L::History>| {
         let (p, i) = (s.p[k] as usize, s.i[k] as usize);
         let Some(r) = touching::<L, PERIODIC>(view, p, i) else {
-            forget(&mut s.history[k], &mut s.active[k]);
+            if s.active[k] {
+                opened(view, k, s, &mut watch.flows);
+            }
             return;
         };
         contact(view, touched, r, k, s, &mut watch);
@@ -322,6 +332,30 @@ fn forget<H: Default>(history: &mut H, active: &mut bool) {
     }
 }
 
+/// A contact in slot `k` of `s` that has just opened: forgets its history, and books what its
+/// springs still held at zero overlap as released by the slider (the Coulomb cap μ·|fn| closes
+/// as the contact opens; when the law splits its dissipation and a free particle is in it). Out
+/// of line and cold: a contact ends once in many pair visits.
+///
+/// # Safety
+/// As [`pair_force`] for the pair in slot `k`.
+#[cold]
+#[inline(never)]
+unsafe fn opened<L: ContactLaw>(
+    view: &PairView<'_, L>,
+    k: usize,
+    s: &mut PairSlots<'_, L::History>,
+    flows: &mut Flows,
+) {
+    let (p, i) = (s.p[k] as usize, s.i[k] as usize);
+    let free = view.inv_mass[p] > 0.0 || view.inv_mass[i] > 0.0;
+    if L::SPLITS_DISSIPATION && free {
+        let held = view.law.stored_energy(0.0, &s.history[k]) - view.law.normal_energy(0.0);
+        flows.dissipated[2] += fixed(held);
+    }
+    forget(&mut s.history[k], &mut s.active[k]);
+}
+
 /// The force of the contact in slot `k` of `s` (separation `r`, overlapping), its run guard
 /// and its particles' `touched` flags, out of line: the loop over all pairs then keeps its
 /// registers for the pairs that do not touch, the great majority.
@@ -343,6 +377,7 @@ unsafe fn contact<L: ContactLaw>(
         return;
     };
     guard_contact(view, p, i, touch, (history, out, &mut s.tally[k]), watch);
+    book_flows(view, p, i, &touch.dissipated, out, &mut watch.flows);
     // only free particles gather (and clear their flag)
     for q in [p, i] {
         if view.inv_mass[q] > 0.0 {
@@ -375,12 +410,48 @@ unsafe fn evaluate<L: ContactLaw>(
     };
     let kin = input.kinematics()?;
     let before = active.then(|| power(out, [input.v_p, input.v_i, input.w_p, input.w_i]));
-    *out = view.law.evaluate(&kin, history, view.dt);
+    let (force, dissipated) = view.law.evaluate_dissipating(&kin, history, view.dt);
+    *out = force;
     *active = true;
     Some(Touch {
         delta: kin.delta,
         before,
+        dissipated,
     })
+}
+
+/// The ledgers' share of a contact just evaluated (force `out` on P, its dissipation over the
+/// step `lost`): with a free particle in it, its dissipation (when the law splits it) and, with
+/// a wall particle, the impulse out.f·dt the wall group receives (I receives −out.f). Part of
+/// [`contact`], off the loop over all pairs.
+#[inline(always)]
+fn book_flows<L: ContactLaw>(
+    view: &PairView<'_, L>,
+    p: usize,
+    i: usize,
+    lost: &Dissipated,
+    out: &PairForce,
+    flows: &mut Flows,
+) {
+    let (wall_p, wall_i) = (view.motion[p], view.motion[i]);
+    let wall = match (wall_p, wall_i) {
+        (Motion::Prescribed(_), Motion::Prescribed(_)) => return,
+        (Motion::Prescribed(g), Motion::Free) => Some((g, out.f)),
+        (Motion::Free, Motion::Prescribed(g)) => Some((g, -out.f)),
+        (Motion::Free, Motion::Free) => None,
+    };
+    if L::SPLITS_DISSIPATION {
+        let d = &mut flows.dissipated;
+        d[0] += fixed(lost.normal);
+        d[1] += fixed(lost.tangential);
+        d[2] += fixed(lost.slide);
+    }
+    if let Some((g, f)) = wall {
+        let j = &mut flows.impulse[usize::from(g.min(1))];
+        for (c, jc) in j.iter_mut().enumerate() {
+            *jc += fixed(f[c] * view.dt);
+        }
+    }
 }
 
 /// The power (energy/time) force `o` delivers to the pair at velocities [v_P, v_I, ω_P, ω_I]:

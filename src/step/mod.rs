@@ -36,6 +36,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
+pub use self::energy::{Flows, LedgerRow, Reading};
 use self::forces::{contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
@@ -84,6 +85,10 @@ pub trait Engine: Send {
     /// the energy the contact took (0 when none gave out more than it took; the guard stops a
     /// run beyond `[guard] contact`).
     fn largest_excess(&self) -> f64;
+    /// The ledgers read at the current step ([`Reading`]; the forces of the step evaluated):
+    /// the energy and momentum flows accumulated over every step run so far, and the state's
+    /// energies and free momentum. Two readings give the ledgers of the steps between them.
+    fn ledger(&self) -> Reading;
     /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
     /// with the reason, when the run guard finds a number that cannot be trusted; after that
     /// every call fails the same way.
@@ -129,6 +134,18 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn largest_excess(&self) -> f64 {
         self.core.pumped
+    }
+    fn ledger(&self) -> Reading {
+        let c = &self.core;
+        let s = &c.state;
+        energy::read(
+            &self.law,
+            &s.particles,
+            &s.domain,
+            c.params.gravity,
+            &c.pairs,
+            (s.step, c.params.dt, c.flows),
+        )
     }
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
@@ -238,6 +255,7 @@ impl<L: ContactLaw> Simulation<L> {
                 w: arr.w,
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
+                motion: arr.motion.slice(0..n),
                 overlap: self.core.params.guard.overlap,
                 excess: self.core.params.guard.contact,
             };
@@ -338,6 +356,7 @@ impl<L: ContactLaw> Simulation<L> {
                     let theirs = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
                     // an integer sum: the same in any order of the threads
                     mine.supplied += theirs.supplied;
+                    mine.flows.add(&theirs.flows);
                     mine.deepest = mine.deepest.max(theirs.deepest);
                     mine.pumped = mine.pumped.max(theirs.pumped);
                 }
@@ -356,6 +375,10 @@ impl<L: ContactLaw> Simulation<L> {
         }
         core.state.step += done.steps;
         let supplied = done.supplied;
+        let mut flows = done.flows;
+        // what the walls did not supply, gravity along periodic axes did
+        flows.gravity_work = supplied - flows.wall_work;
+        core.flows.add(&flows);
         if let Some((_, b)) = breach {
             let state = &mut core.state;
             core.failure = Some(b.report(state.step, state.time, &state.id));
@@ -367,13 +390,15 @@ impl<L: ContactLaw> Simulation<L> {
 
 /// What a thread's run leaves: its counters, the displacement bounds at the end, the steps
 /// completed (fewer than asked when the run guard stops the run: every thread stops at the same
-/// meeting), the work supplied in its passes (fixed point), the largest overlap and the largest
+/// meeting), the work supplied in its passes (fixed point), the ledgers' flows of its passes
+/// (all but the work of gravity, which is in `supplied`), the largest overlap and the largest
 /// excess of a contact's energy account it saw.
 struct Done {
     times: StageTimes,
     bound: [f64; 2],
     steps: u64,
     supplied: i128,
+    flows: Flows,
     deepest: f64,
     pumped: f64,
 }
@@ -416,6 +441,8 @@ struct Worker<'t, 'a, L: ContactLaw> {
     /// Work of the walls and of gravity along periodic axes on the free particles in this
     /// thread's passes, in fixed point (the run guard's energy balance).
     supplied: i128,
+    /// The ledgers' flows in this thread's pair passes (the walls' work among them).
+    flows: Flows,
     /// Largest overlap of its pair passes, as a fraction of the smaller radius.
     deepest: f64,
     /// Largest excess of a contact's energy account in its pair passes, as a fraction of what
@@ -434,6 +461,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             times: StageTimes::default(),
             laps: Laps::new(tid == 0),
             supplied: 0,
+            flows: Flows::default(),
             deepest: 0.0,
             pumped: 0.0,
         }
@@ -470,6 +498,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             bound: self.bound,
             steps,
             supplied: self.supplied,
+            flows: self.flows,
             deepest: self.deepest,
             pumped: self.pumped,
         }
@@ -609,6 +638,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                 w: arr.w,
                 radius: arr.radius.slice(0..n),
                 inv_mass: arr.inv_mass.slice(0..n),
+                motion: arr.motion.slice(0..n),
                 overlap: team.guard.overlap,
                 excess: team.guard.contact,
             };
@@ -616,6 +646,8 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             while let Some(c) = team.pair_queue.next(self.tid) {
                 let watch = pair_chunk(&view, arr, touched, c, closed);
                 self.supplied += watch.wall_work;
+                self.flows.add(&watch.flows);
+                self.flows.wall_work += watch.wall_work;
                 self.deepest = self.deepest.max(watch.worst);
                 self.pumped = self.pumped.max(watch.pumped);
                 if watch.worst > team.guard.overlap || watch.pumped > team.guard.contact {

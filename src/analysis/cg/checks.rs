@@ -157,6 +157,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     );
     // 2. Wall consistency: σ·n at each wall equals the wall force per area. Top wall (normal
     // +z): σxz = F_top,x/A, σzz = F_top,z/A; bottom wall: σxz = −F_bot,x/A, σzz = −F_bot,z/A.
+    // The wall forces are every step's when the run's diagnostics have the ledgers.
     let area = p.domain.lengths().x * p.domain.lengths().y;
     let blocks = p.blocks;
     let per_block = |f: &dyn Fn(usize) -> f64| -> (f64, f64) {
@@ -183,6 +184,11 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         standard_error(&vals)
     };
     let tau_se = block_core(&|c| c[col("shear_xz")]);
+    let source = if p.wall_force_every_step {
+        "wall forces: every step's, averaged over each save's interval"
+    } else {
+        "wall forces: at the saves"
+    };
     let zz_core_se = block_core(&|c| c[col("kin_zz")] + c[col("con_zz")]);
     for (label, g, sign) in [("top", 1usize, 1.0), ("bottom", 0usize, -1.0)] {
         let (fx, fx_se) = per_block(&|s| sign * p.wall_force[s][g].x / area);
@@ -204,12 +210,32 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
                 )
                 .judged_if(judged)
                 .described(
-                    format!("{:.5} vs {:.5}", Shown(gap), Shown(wall)),
+                    format!("{:.5} vs {:.5} ({source})", Shown(gap), Shown(wall)),
                     format!("difference < 3 combined SE ({:.2e}){unjudged}", Shown(tol)),
                 ),
             );
         }
     }
+    // The shear stress the two walls transmit together, (F_top,x − F_bottom,x)/(2A): in a
+    // steady state the x-momentum the top wall puts in leaves through the bottom one.
+    let (fx, fx_se) = per_block(&|s| 0.5 * (p.wall_force[s][1].x - p.wall_force[s][0].x) / area);
+    let tol = 3.0 * (tau_se * tau_se + fx_se * fx_se).sqrt();
+    out.push(
+        Verdict::judge(
+            "",
+            "sigma_xz in the core = (F_top,x - F_bottom,x)/2 per area",
+            tau_mean - fx,
+            Limit::Absolute {
+                expected: 0.0,
+                tolerance: tol,
+            },
+        )
+        .judged_if(judged)
+        .described(
+            format!("{:.5} vs {:.5} ({source})", Shown(tau_mean), Shown(fx)),
+            format!("difference < 3 combined SE ({:.2e}){unjudged}", Shown(tol)),
+        ),
+    );
     // 3. Mass: ∫ ν dz · Lx·Ly = Σ V_i, per save.
     let h = p.grid.h();
     let worst = p

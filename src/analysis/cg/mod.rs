@@ -205,8 +205,12 @@ pub struct Profiles {
     pub se: Vec<Vec<f64>>,
     /// Per save: the raw fields (for the checks).
     pub per_save: Vec<Raw>,
-    /// Per save: force of the free particles on the bottom and top walls (from the fstat rows).
+    /// Per save: force of the free particles on the bottom and top walls: the mean over the
+    /// save's interval of the force of every step (the ledger columns of the run's diagnostics,
+    /// when they cover every save), else the force at the save (from the fstat rows).
     pub wall_force: Vec<[crate::Vec3; 2]>,
+    /// Whether `wall_force` holds every-step means (true) or the forces at the saves.
+    pub wall_force_every_step: bool,
     pub domain: Domain,
     /// Number of free particles and their total volume.
     pub free: usize,
@@ -268,6 +272,30 @@ pub fn columns(d: &Derived) -> Vec<f64> {
     c
 }
 
+/// The mean force of every step on the bottom and top walls over the interval ending at each
+/// of `saves`, from the ledger columns of the series' diagnostics table, when it has them for
+/// every one of those saves; `None` otherwise (no table, an older table, a save without a
+/// ledger).
+fn every_step_wall_forces(
+    series: &Series,
+    saves: &[u64],
+) -> anyhow::Result<Option<Vec<[crate::Vec3; 2]>>> {
+    let path = series.dir.join(format!("{}.diagnostics.csv", series.name));
+    if !path.exists() {
+        return Ok(None);
+    }
+    let Some(records) = crate::io::diagnostics::read_ledgers(&path)? else {
+        return Ok(None);
+    };
+    Ok(saves
+        .iter()
+        .map(|&k| {
+            let r = records.iter().find(|r| r.save == k)?;
+            r.ledger.as_ref().map(|l| l.mean_wall_force)
+        })
+        .collect())
+}
+
 /// Coarse-grains a series.
 pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> {
     let n = series.saves.len();
@@ -314,6 +342,9 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         per_save.push(raw);
         wall_force.push(wf);
     }
+    let every_step = every_step_wall_forces(series, &saves)?;
+    let wall_force_every_step = every_step.is_some();
+    let wall_force = every_step.unwrap_or(wall_force);
     let mean_raw = average(&per_save);
     let mean = derive(&mean_raw);
     let blocks = o.blocks.clamp(1, per_save.len());
@@ -360,6 +391,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         se,
         per_save,
         wall_force,
+        wall_force_every_step,
         domain,
         free,
         free_volume,
@@ -418,7 +450,12 @@ pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, String
     let p = coarse_grain(&series, o)?;
     let out = |ext: &str| series.dir.join(format!("{}.{ext}", series.name));
     crate::io::atomic::write(&out("profiles.csv"), csv(&p).as_bytes())?;
-    let report = checks::report(&p, &checks::run(&p, o.density));
+    let mut report = checks::report(&p, &checks::run(&p, o.density));
+    report.push_str(&crate::analysis::ledger::section(
+        &series.dir,
+        &series.name,
+        &p.saves,
+    )?);
     crate::io::atomic::write(&out("checks.txt"), report.as_bytes())?;
     plot::profiles_png(&p, &out("profiles.png"))?;
     Ok((p, report))

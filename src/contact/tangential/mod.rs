@@ -47,6 +47,24 @@ pub trait TangentialModel: Send + Sync {
 
     /// Elastic energy held by the tangential spring of history `xi` (energy units).
     fn stored_energy(&self, xi: &Self::History) -> f64;
+
+    /// Whether [`TangentialModel::force_dissipating`] is implemented (false by default: the
+    /// law's dissipation is then not split).
+    const SPLITS_DISSIPATION: bool = false;
+
+    /// [`TangentialModel::force`] (bit for bit), and the energy (energy units) its dashpot and
+    /// its Coulomb slider took over the step, `[dashpot, slider]` (see
+    /// [`crate::contact::Dissipated`]). Zeros by default (not split).
+    #[inline(always)]
+    fn force_dissipating(
+        &self,
+        k: &PairKinematics,
+        fn_signed: f64,
+        xi: &mut Self::History,
+        dt: f64,
+    ) -> (Vec3, [f64; 2]) {
+        (self.force(k, fn_signed, xi, dt), [0.0; 2])
+    }
 }
 
 /// No tangential force at all (mu = 0 or no friction requested).
@@ -64,6 +82,9 @@ impl TangentialModel for Frictionless {
     fn stored_energy(&self, _: &Vec3) -> f64 {
         0.0
     }
+
+    /// No tangential force takes any energy.
+    const SPLITS_DISSIPATION: bool = true;
 }
 
 /// The normal of the previous step, n_old = (r − (v_P − v_I)·dt)/|…| (unit, from I to P).
@@ -107,16 +128,44 @@ impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
 
     #[inline(always)]
     fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3 {
-        let slip = S::slip(k, dt);
-        let fcrit = self.mu * fn_signed.abs();
-        let skip_below = 1e-10 * fcrit / self.kt;
-        U::advance(xi, slip, k, dt, skip_below);
-        C::cap(xi, slip, fcrit, self.kt, self.gammat)
+        self.force_dissipating(k, fn_signed, xi, dt).0
     }
 
     /// ½·kt·|ξ|²: the spring's elastic force on P is −kt·ξ.
     fn stored_energy(&self, xi: &Vec3) -> f64 {
         0.5 * self.kt * xi.norm_squared()
+    }
+
+    const SPLITS_DISSIPATION: bool = true;
+
+    /// The dashpot takes −(Ft + kt·ξ)·slip·dt, the part of the force Ft the spring ξ (after the
+    /// cap) does not give, against the slip. The slider takes what the cap's reset released
+    /// from the spring, ½·kt·(|ξ₁|² − |ξ₂|²) (ξ₁ the spring before the cap, ξ₂ after it), less
+    /// ½·kt·(ξ₁ − ξ₂)·(ξ₁ − ξ₀) (ξ₀ the spring at the start of the step): the part of the release
+    /// the spring's force never did as work over this step's increment ξ₁ − ξ₀. With it the
+    /// spring's work over the steps, its energy and the slider's share telescope exactly: a
+    /// contact sliding steadily gives kt·ξ₂·slip·dt, an abrupt reset with no increment the whole
+    /// release.
+    #[inline(always)]
+    fn force_dissipating(
+        &self,
+        k: &PairKinematics,
+        fn_signed: f64,
+        xi: &mut Vec3,
+        dt: f64,
+    ) -> (Vec3, [f64; 2]) {
+        let slip = S::slip(k, dt);
+        let fcrit = self.mu * fn_signed.abs();
+        let skip_below = 1e-10 * fcrit / self.kt;
+        let start = *xi;
+        U::advance(xi, slip, k, dt, skip_below);
+        let stretched = *xi;
+        let f = C::cap(xi, slip, fcrit, self.kt, self.gammat);
+        let dashpot = -(f + self.kt * *xi).dot(&slip) * dt;
+        let reset = stretched - *xi;
+        let released = stretched.norm_squared() - xi.norm_squared();
+        let slide = 0.5 * self.kt * (released - reset.dot(&(stretched - start)));
+        (f, [dashpot, slide])
     }
 }
 
