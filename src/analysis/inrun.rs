@@ -58,6 +58,27 @@ pub fn intervals(case: &Case, every: Option<u64>, particle_every: Option<u64>) -
     (every, particle_every)
 }
 
+/// The sampling of a run that starts at step `start` and ends at `end_step`, a save every
+/// `save_every` steps, its folder's first save `first_save`: the steps of the saves `verdem cg`
+/// averages by default (the second half of the run's saves, after the first save of that half),
+/// at the intervals `every` and `particle_every` (steps).
+pub fn second_half(
+    (every, particle_every): (u64, u64),
+    first_save: u64,
+    start: u64,
+    end_step: u64,
+    save_every: u64,
+) -> Sampling {
+    let n = (end_step / save_every + 1).saturating_sub(first_save);
+    let from = (first_save + n.div_ceil(2).min(n.saturating_sub(1))) * save_every;
+    Sampling {
+        every,
+        particle_every,
+        from: from.max(start),
+        to: end_step,
+    }
+}
+
 /// When to sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Sampling {
@@ -95,18 +116,6 @@ pub struct Inrun {
     /// The time step, when the errors take no τ below the benchmark's reference
     /// ([`blocking::REFERENCE_TAU`]).
     reference_dt: Option<f64>,
-}
-
-/// The default sampling intervals (steps) of a run whose free–free contact lasts `tc_steps`
-/// steps: contact stress every [`CONTACTS_PER_SAMPLE`] contact durations, particle fields at the
-/// multiple of that nearest to [`CONTACTS_PER_PARTICLE_SAMPLE`] durations.
-pub fn default_intervals(tc_steps: f64) -> (u64, u64) {
-    let every = (tc_steps * CONTACTS_PER_SAMPLE).round().max(1.0) as u64;
-    let target = CONTACTS_PER_PARTICLE_SAMPLE * tc_steps;
-    (
-        every,
-        ((target / every as f64).round().max(1.0) as u64) * every,
-    )
 }
 
 impl Inrun {

@@ -9,7 +9,7 @@ use anyhow::Context;
 
 use verdem::analysis::cg::blocking::{self, Unit};
 use verdem::analysis::cg::{self, CgOptions};
-use verdem::analysis::inrun::{self, Inrun, Sampling};
+use verdem::analysis::inrun::{self, Inrun};
 use verdem::analysis::particles;
 use verdem::case::{Case, Scene};
 use verdem::io::vtk::Particle;
@@ -267,15 +267,13 @@ fn in_run(
     } else {
         start.div_ceil(opts.save_every)
     };
-    let last = opts.end_step / opts.save_every;
-    let n = (last + 1).saturating_sub(first);
-    let from = (first + n.div_ceil(2).min(n.saturating_sub(1))) * opts.save_every;
-    let sampling = Sampling {
-        every,
-        particle_every,
-        from: from.max(start),
-        to: opts.end_step,
-    };
+    let sampling = inrun::second_half(
+        (every, particle_every),
+        first,
+        start,
+        opts.end_step,
+        opts.save_every,
+    );
     Ok(Some(
         Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
             .with_reference_tau(case.dt()),

@@ -24,7 +24,7 @@ use crate::analysis::cg::blocking;
 use crate::analysis::cg::table::Table;
 use crate::analysis::cg::{self, CgOptions};
 use crate::analysis::ensemble::{self as merge, Coverage};
-use crate::analysis::inrun::{self, Inrun, Sampling};
+use crate::analysis::inrun::{self, Inrun};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::io::{atomic, hash};
@@ -376,17 +376,13 @@ fn in_run(
     if !matches!(case.scene, crate::case::Scene::BumpyShear { .. }) {
         return Ok(None);
     }
-    let tc_steps = case.tc_free_free().map_or(50.0, |tc| tc / case.dt());
-    let (every, particle_every) = inrun::default_intervals(tc_steps);
-    let first = start.div_ceil(opts.save_every);
-    let saves = (opts.end_step / opts.save_every + 1).saturating_sub(first);
-    let from = (first + saves.div_ceil(2).min(saves.saturating_sub(1))) * opts.save_every;
-    let sampling = Sampling {
-        every,
-        particle_every,
-        from: from.max(start),
-        to: opts.end_step,
-    };
+    let sampling = inrun::second_half(
+        inrun::intervals(case, None, None),
+        start.div_ceil(opts.save_every),
+        start,
+        opts.end_step,
+        opts.save_every,
+    );
     Ok(Some(
         Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
             .with_reference_tau(case.dt()),
