@@ -1,6 +1,8 @@
 //! The command line: bad values are refused with the option named, before any work; what a
 //! run prints and writes at its edges (a resume, a scene other than the shear cell).
 
+mod common;
+
 use std::process::Command;
 
 /// What a run of `verdem` ended with.
@@ -278,13 +280,19 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     };
     assert!(hash(&straight.out).is_some());
     assert_eq!(hash(&resumed.out), hash(&straight.out));
-    for name in [
-        "shear_flow_quick.data.0040",
-        "shear_flow_quick.fstat.0003",
-        "shear_flow_quick.diagnostics.csv",
-    ] {
+    for name in ["shear_flow_quick.data.0040", "shear_flow_quick.fstat.0003"] {
         let a = std::fs::read(stopped.path().join(name)).unwrap();
         let b = std::fs::read(straight_dir.path().join(name)).unwrap();
         assert!(a == b, "{name} differs");
     }
+    let diagnostics = |d: &std::path::Path| {
+        std::fs::read_to_string(d.join("shear_flow_quick.diagnostics.csv")).unwrap()
+    };
+    // save s is on line s + 1; the first save after the resume is save step/1000 + 1
+    common::assert_resumed_diagnostics(
+        &diagnostics(stopped.path()),
+        &diagnostics(straight_dir.path()),
+        (step / 1000 + 2) as usize,
+        !step.is_multiple_of(1000),
+    );
 }

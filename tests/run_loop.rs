@@ -59,36 +59,8 @@ fn resumed_run_matches_uninterrupted_run_bit_for_bit() {
     }
     let diag =
         |d: &std::path::Path| std::fs::read_to_string(run::diagnostics_path(d, "q")).unwrap();
-    let (resumed, uninterrupted) = (diag(dir.path()), diag(full_dir.path()));
-    let (resumed, uninterrupted): (Vec<&str>, Vec<&str>) =
-        (resumed.lines().collect(), uninterrupted.lines().collect());
-    assert_eq!(resumed.len(), uninterrupted.len());
-    // The state columns are the same, bit for bit. The ledgers are not in the checkpoint: the
-    // first save after a resume between saves (save 2, step 2000) has none; the ledger of the
-    // next agrees to 1e-6 of each column's largest value (the slider's share of a contact
-    // differs after the resume by about 1e-7 of the interval's dissipation: not yet explained).
-    let state_columns = 10;
-    for (k, (a, b)) in resumed.iter().zip(&uninterrupted).enumerate() {
-        let (a, b): (Vec<&str>, Vec<&str>) = (a.split(',').collect(), b.split(',').collect());
-        assert_eq!(a[..state_columns], b[..state_columns], "row {k}");
-        match k {
-            0..=2 => assert_eq!(a, b, "row {k}"),
-            3 => assert!(a[state_columns..].iter().all(|f| f.is_empty()), "{a:?}"),
-            _ => {
-                let num = |f: &str| f.parse::<f64>().unwrap();
-                let scale = b[state_columns..]
-                    .iter()
-                    .map(|f| num(f).abs())
-                    .fold(0.0, f64::max);
-                for (x, y) in a[state_columns..].iter().zip(&b[state_columns..]) {
-                    assert!(
-                        (num(x) - num(y)).abs() <= 1e-6 * scale,
-                        "row {k}: {x} vs {y}"
-                    );
-                }
-            }
-        }
-    }
+    // The resume is at step 1500, between saves 1 and 2 (lines 2 and 3).
+    common::assert_resumed_diagnostics(&diag(dir.path()), &diag(full_dir.path()), 3, true);
 }
 
 /// A checkpoint of another case, a truncated one and a file that is none are refused.
