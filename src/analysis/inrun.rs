@@ -155,6 +155,13 @@ impl Inrun {
         })
     }
 
+    /// The accumulator of a bumpy-shear run of `case` in `domain`: the case's coarse-graining
+    /// ([`CgOptions::for_case`]), errors with the benchmark's reference τ
+    /// ([`Inrun::with_reference_tau`]).
+    pub fn for_case(case: &Case, domain: &Domain, sampling: Sampling) -> anyhow::Result<Inrun> {
+        Ok(Inrun::new(&CgOptions::for_case(case), domain, sampling)?.with_reference_tau(case.dt()))
+    }
+
     /// The same accumulator whose errors take no τ below the bumpy-shear benchmark's reference
     /// ([`blocking::REFERENCE_TAU`], in time units; the run's time step is `dt`): one run of a
     /// few of its slow fluctuations measures their τ too small.

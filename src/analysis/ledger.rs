@@ -201,15 +201,7 @@ pub fn section(dir: &Path, name: &str, saves: &[u64]) -> anyhow::Result<String> 
         s.push_str("info  no ledger over these saves (a run's first save has none)\n");
     }
     for c in &verdicts {
-        let verdict = match c.pass() {
-            Some(true) => "PASS",
-            Some(false) => "FAIL",
-            None => "info",
-        };
-        s.push_str(&format!(
-            "{verdict:4}  {}: {} (expected {})\n",
-            c.quantity, c.measured_text, c.expected_text
-        ));
+        s.push_str(&crate::analysis::cg::checks::line(c));
     }
     Ok(s)
 }

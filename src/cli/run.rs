@@ -274,10 +274,11 @@ fn in_run(
         opts.end_step,
         opts.save_every,
     );
-    Ok(Some(
-        Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
-            .with_reference_tau(case.dt()),
-    ))
+    Ok(Some(Inrun::for_case(
+        case,
+        &engine.state().domain,
+        sampling,
+    )?))
 }
 
 /// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has

@@ -383,10 +383,11 @@ fn in_run(
         opts.end_step,
         opts.save_every,
     );
-    Ok(Some(
-        Inrun::new(&CgOptions::for_case(case), &engine.state().domain, sampling)?
-            .with_reference_tau(case.dt()),
-    ))
+    Ok(Some(Inrun::for_case(
+        case,
+        &engine.state().domain,
+        sampling,
+    )?))
 }
 
 /// The ensemble of the replicas' in-run profiles and the coverage of their own errors, the

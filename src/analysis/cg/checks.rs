@@ -355,6 +355,20 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     out
 }
 
+/// One line of a checks report: PASS, FAIL or info, what was judged, the measurement and
+/// what was expected.
+pub fn line(c: &Check) -> String {
+    let verdict = match c.pass() {
+        Some(true) => "PASS",
+        Some(false) => "FAIL",
+        None => "info",
+    };
+    format!(
+        "{verdict:4}  {}: {} (expected {})\n",
+        c.quantity, c.measured_text, c.expected_text
+    )
+}
+
 /// A plain-text table of the checks, with the averaging facts a reviewer needs.
 pub fn report(p: &Profiles, checks: &[Check]) -> String {
     let block_len = p.saves.len() as f64 / p.blocks as f64;
@@ -382,15 +396,7 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
         block_len,
     );
     for c in checks {
-        let verdict = match c.pass() {
-            Some(true) => "PASS",
-            Some(false) => "FAIL",
-            None => "info",
-        };
-        s.push_str(&format!(
-            "{verdict:4}  {}: {} (expected {})\n",
-            c.quantity, c.measured_text, c.expected_text
-        ));
+        s.push_str(&line(c));
     }
     if let Some(note) = unsteady_note(checks) {
         s.push_str(note);
