@@ -62,7 +62,7 @@ pub fn intervals(case: &Case, every: Option<u64>, particle_every: Option<u64>) -
 /// `save_every` steps, its folder's first save `first_save`: the steps of the saves `verdem cg`
 /// averages by default (the second half of the run's saves, after the first save of that half),
 /// at the intervals `every` and `particle_every` (steps).
-pub fn second_half(
+fn second_half(
     (every, particle_every): (u64, u64),
     first_save: u64,
     start: u64,
@@ -155,11 +155,26 @@ impl Inrun {
         })
     }
 
-    /// The accumulator of a bumpy-shear run of `case` in `domain`: the case's coarse-graining
-    /// ([`CgOptions::for_case`]), errors with the benchmark's reference τ
-    /// ([`Inrun::with_reference_tau`]).
-    pub fn for_case(case: &Case, domain: &Domain, sampling: Sampling) -> anyhow::Result<Inrun> {
-        Ok(Inrun::new(&CgOptions::for_case(case), domain, sampling)?.with_reference_tau(case.dt()))
+    /// The accumulator of the bumpy-shear run `opts` of `case` on `engine` (from its current
+    /// step), its folder's first save `first_save`: the saves' window ([`second_half`]) at
+    /// `intervals` (steps), the case's coarse-graining ([`CgOptions::for_case`]) and errors with
+    /// the benchmark's reference τ ([`Inrun::with_reference_tau`]).
+    pub fn for_run(
+        case: &Case,
+        engine: &dyn Engine,
+        opts: &crate::run::RunOptions,
+        intervals: (u64, u64),
+        first_save: u64,
+    ) -> anyhow::Result<Inrun> {
+        let sampling = second_half(
+            intervals,
+            first_save,
+            engine.state().step,
+            opts.end_step,
+            opts.save_every,
+        );
+        let o = CgOptions::for_case(case);
+        Ok(Inrun::new(&o, &engine.state().domain, sampling)?.with_reference_tau(case.dt()))
     }
 
     /// The same accumulator whose errors take no τ below the bumpy-shear benchmark's reference

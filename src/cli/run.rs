@@ -267,17 +267,12 @@ fn in_run(
     } else {
         start.div_ceil(opts.save_every)
     };
-    let sampling = inrun::second_half(
+    Ok(Some(Inrun::for_run(
+        case,
+        engine,
+        opts,
         (every, particle_every),
         first,
-        start,
-        opts.end_step,
-        opts.save_every,
-    );
-    Ok(Some(Inrun::for_case(
-        case,
-        &engine.state().domain,
-        sampling,
     )?))
 }
 

@@ -205,7 +205,6 @@ impl Plan {
             },
         );
         let start_hash = hash::state_hash(&engine.snapshot());
-        let start_step = engine.state().step;
         let dir = replica_dir(&self.out, k);
         run::claim_output_folder(&dir, &case.name, true, "--replica")?;
         let opts = RunOptions {
@@ -220,7 +219,7 @@ impl Plan {
             vtk: false,
             stop: None,
         };
-        let mut inrun = in_run(&case, engine.as_ref(), &opts, start_step)?;
+        let mut inrun = in_run(&case, engine.as_ref(), &opts)?;
         let s = run::run_observed(
             engine.as_mut(),
             &opts,
@@ -366,27 +365,21 @@ impl Plan {
 
 /// The in-run averaging of a replica of a bumpy-shear `case` (none for other scenes), as
 /// `verdem run` samples by default: over the steps of the second half of the saves the replica
-/// writes from `start` (its first step), with the benchmark's reference τ as the errors' floor.
+/// writes from the engine's current step, with the benchmark's reference τ as the errors' floor.
 fn in_run(
     case: &Case,
     engine: &dyn crate::step::Engine,
     opts: &RunOptions,
-    start: u64,
 ) -> anyhow::Result<Option<Inrun>> {
     if !matches!(case.scene, crate::case::Scene::BumpyShear { .. }) {
         return Ok(None);
     }
-    let sampling = inrun::second_half(
-        inrun::intervals(case, None, None),
-        start.div_ceil(opts.save_every),
-        start,
-        opts.end_step,
-        opts.save_every,
-    );
-    Ok(Some(Inrun::for_case(
+    Ok(Some(Inrun::for_run(
         case,
-        &engine.state().domain,
-        sampling,
+        engine,
+        opts,
+        inrun::intervals(case, None, None),
+        engine.state().step.div_ceil(opts.save_every),
     )?))
 }
 
