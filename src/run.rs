@@ -219,6 +219,8 @@ pub fn claim_output_folder(
 pub trait Observer {
     /// The first step after `step` the observer wants to look at, if any.
     fn next_after(&self, step: u64) -> Option<u64>;
+    /// Looks at the engine's step when the run starts (nothing by default).
+    fn start(&mut self, _engine: &dyn Engine) {}
     /// Looks at the engine's current step.
     fn observe(&mut self, engine: &dyn Engine);
 }
@@ -259,6 +261,9 @@ pub fn run_observed(
         )?),
     };
     let bar = progress_bar(opts, start_step);
+    if let Some(o) = observer.as_deref_mut() {
+        o.start(engine);
+    }
     // The ledgers' reading at the last save; a run resumed between saves has none until its
     // first save.
     let mut last_reading =

@@ -76,12 +76,12 @@ fn steady_run(
     .unwrap();
     let opts = options(dir.path(), steps, save_every, true);
     run::run_observed(e.as_mut(), &opts, false, Some(&mut inrun)).unwrap();
-    // The saves' wall forces from their .fstat rows, sampled as the in-run ones are: with the
-    // diagnostics' ledgers, cg would take every step's means instead.
-    std::fs::remove_file(run::diagnostics_path(dir.path(), "s")).unwrap();
+    // Both take the walls' every-step mean forces: cg from the diagnostics' ledgers over each
+    // save's interval, the accumulator from the engine's impulse over each bin.
     let saves = cg::coarse_grain(&Series::find(&dir.path().join("s")).unwrap(), &o).unwrap();
-    assert!(!saves.wall_force_every_step);
-    (saves, inrun.result().unwrap())
+    let inrun = inrun.result().unwrap();
+    assert!(saves.wall_force_every_step && inrun.profiles.wall_force_every_step);
+    (saves, inrun)
 }
 
 #[test]
@@ -106,7 +106,9 @@ fn sampling_the_saves_steps_gives_the_saves_profiles() {
             );
         }
     }
-    // and the wall forces per save equal the saves' .fstat rows
+    // and the walls' mean force over each bin (the steps of a save's interval) equals the
+    // diagnostics' mean over that save's interval: the same impulse, read twice
+    assert_eq!(saves.wall_force.len(), inrun.profiles.wall_force.len());
     for (s, w) in saves.wall_force.iter().zip(&inrun.profiles.wall_force) {
         for g in 0..2 {
             assert!(

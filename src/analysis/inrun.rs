@@ -1,8 +1,10 @@
 //! In-run averaging: the coarse-grained raw fields of `verdem cg` (the same slices, kernels and
 //! definitions, [`Raw::add_particle`] and [`Raw::add_contact`]) accumulated while a run
 //! advances, from the engine's own contacts and forces rather than from saves: the contact
-//! stress of the contacts alive every `every` steps, the force each wall receives at the same
-//! steps, and the particle fields every `particle_every` steps. Samples go into bins of
+//! stress of the contacts alive every `every` steps, the mean force each wall receives over
+//! every step (its impulse from the engine's ledger over the time; from a peer's dumps, which
+//! carry no impulse, the force at the sampled steps), and the particle fields every
+//! `particle_every` steps. Samples go into bins of
 //! consecutive steps (at most [`MAX_BINS`]; two neighbours merge when more would be needed), and
 //! the bins are the series the profiles' standard errors are taken from, with blocks as long as
 //! each field's own correlation ([`blocking::field_errors`]).
@@ -106,6 +108,14 @@ pub struct Inrun {
     /// Per bin: the sum over its contact samples of the force of the free particles on the
     /// bottom [0] and top [1] wall spheres.
     wall: Vec<[Vec3; 2]>,
+    /// Per bin: the impulse the free particles gave the bottom [0] and top [1] wall spheres
+    /// over the steps it covers, divided by the time step (force × steps), and those steps;
+    /// zero steps when the samples come without an engine (a peer's dumps).
+    impulse: Vec<[Vec3; 2]>,
+    impulse_steps: Vec<u64>,
+    /// The step the engine was last observed at and the walls' impulse since its first step
+    /// there ([`crate::step::Reading::wall_impulse`]).
+    mark: Option<(u64, [Vec3; 2])>,
     /// The contact stress of the sample under way.
     scratch: Raw,
     /// Per contact sample (the first [`TRACE_SAMPLES`]): the core means of the contact pressure
@@ -148,6 +158,9 @@ impl Inrun {
             bin_steps: sampling.particle_every,
             bins: Vec::new(),
             wall: Vec::new(),
+            impulse: Vec::new(),
+            impulse_steps: Vec::new(),
+            mark: None,
             trace: Vec::new(),
             free: 0,
             free_volume: 0.0,
@@ -189,16 +202,7 @@ impl Inrun {
     /// the bin of its step: the contact stress and wall forces, and the particle fields when
     /// `particles`. Samples must come in the order of their steps, each in (`from`, `to`].
     pub fn sample(&mut self, snap: &Snapshot, particles: bool) {
-        let step = snap.step;
-        let mut b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
-        while b >= MAX_BINS {
-            self.merge_neighbours();
-            b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
-        }
-        while self.bins.len() <= b {
-            self.bins.push(Unit::empty(self.grid.n));
-            self.wall.push([Vec3::zeros(); 2]);
-        }
+        let b = self.bin_of(snap.step);
         let p = &snap.particles;
         let (grid, kernel, area, density) = (&self.grid, self.kernel, self.area, self.density);
         let unit = &mut self.bins[b];
@@ -264,20 +268,60 @@ impl Inrun {
         }
     }
 
+    /// The bin of `step` (in (`from`, `to`]), made with the bins before it if it is new.
+    fn bin_of(&mut self, step: u64) -> usize {
+        let mut b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
+        while b >= MAX_BINS {
+            self.merge_neighbours();
+            b = ((step - self.sampling.from - 1) / self.bin_steps) as usize;
+        }
+        while self.bins.len() <= b {
+            self.bins.push(Unit::empty(self.grid.n));
+            self.wall.push([Vec3::zeros(); 2]);
+            self.impulse.push([Vec3::zeros(); 2]);
+            self.impulse_steps.push(0);
+        }
+        b
+    }
+
+    /// Books the walls' impulse since the engine was last observed into the bin of its
+    /// current step, and marks that step.
+    fn book_impulse(&mut self, engine: &dyn Engine) {
+        let reading = engine.ledger();
+        let now = (reading.step, reading.wall_impulse());
+        if let Some((before, at_before)) = self.mark {
+            if now.0 > before {
+                let b = self.bin_of(now.0);
+                for g in 0..2 {
+                    self.impulse[b][g] += (now.1[g] - at_before[g]) / reading.dt;
+                }
+                self.impulse_steps[b] += now.0 - before;
+            }
+        }
+        self.mark = Some(now);
+    }
+
     /// Halves the number of bins: bins 2j and 2j + 1 become bin j, twice as long.
     fn merge_neighbours(&mut self) {
         let bins = std::mem::take(&mut self.bins);
         let wall = std::mem::take(&mut self.wall);
-        for (pair, w) in bins.chunks(2).zip(wall.chunks(2)) {
+        let impulse = std::mem::take(&mut self.impulse);
+        let steps = std::mem::take(&mut self.impulse_steps);
+        for (k, pair) in bins.chunks(2).enumerate() {
             let mut u = pair[0].clone();
-            let mut f = w[0];
-            if let (Some(second), Some(g)) = (pair.get(1), w.get(1)) {
+            let (mut f, mut j, mut n) = (wall[2 * k], impulse[2 * k], steps[2 * k]);
+            if let Some(second) = pair.get(1) {
                 u.merge(second);
-                f[0] += g[0];
-                f[1] += g[1];
+                for g in 0..2 {
+                    f[g] += wall[2 * k + 1][g];
+                    j[g] += impulse[2 * k + 1][g];
+                }
+                n += steps[2 * k + 1];
             }
             self.bins.push(u);
             self.wall.push(f);
+            self.impulse.push(j);
+            self.impulse_steps.push(n);
         }
         self.bin_steps *= 2;
     }
@@ -292,6 +336,8 @@ impl Inrun {
             return None;
         }
         let units: Vec<Unit> = kept.iter().map(|&b| self.bins[b].clone()).collect();
+        // The walls' every-step mean forces when the engine's impulse covers every bin kept.
+        let every_step = kept.iter().all(|&b| self.impulse_steps[b] > 0);
         let floor = match self.reference_dt {
             Some(dt) => blocking::reference_floor(self.bin_steps as f64 * dt),
             None => vec![0.0; COLUMNS.len()],
@@ -316,11 +362,16 @@ impl Inrun {
             wall_force: kept
                 .iter()
                 .map(|&b| {
-                    let n = self.bins[b].contact_samples as f64;
-                    [self.wall[b][0] / n, self.wall[b][1] / n]
+                    if every_step {
+                        let n = self.impulse_steps[b] as f64;
+                        [self.impulse[b][0] / n, self.impulse[b][1] / n]
+                    } else {
+                        let n = self.bins[b].contact_samples as f64;
+                        [self.wall[b][0] / n, self.wall[b][1] / n]
+                    }
                 })
                 .collect(),
-            wall_force_every_step: false,
+            wall_force_every_step: every_step,
             domain: self.domain.clone(),
             free: self.free,
             free_volume: self.free_volume,
@@ -346,16 +397,32 @@ impl Inrun {
     }
 }
 
+/// The run loop stops at `from` too, where the walls' impulse starts to count, and at each
+/// contact sample after it, where the impulse since the last stop is booked.
 impl Observer for Inrun {
     fn next_after(&self, step: u64) -> Option<u64> {
         let s = self.sampling;
-        let next = (step.max(s.from) / s.every + 1) * s.every;
+        if step < s.from {
+            return Some(s.from);
+        }
+        let next = (step / s.every + 1) * s.every;
         (next <= s.to).then_some(next)
+    }
+
+    fn start(&mut self, engine: &dyn Engine) {
+        let step = engine.state().step;
+        if step >= self.sampling.from && step < self.sampling.to {
+            self.book_impulse(engine);
+        }
     }
 
     fn observe(&mut self, engine: &dyn Engine) {
         let step = engine.state().step;
-        if step <= self.sampling.from || step > self.sampling.to {
+        if step < self.sampling.from || step > self.sampling.to {
+            return;
+        }
+        self.book_impulse(engine);
+        if step == self.sampling.from {
             return;
         }
         let particles = step.is_multiple_of(self.sampling.particle_every);

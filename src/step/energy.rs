@@ -231,6 +231,12 @@ pub struct LedgerRow {
 }
 
 impl Reading {
+    /// The impulse the free particles gave wall group 0 and 1 since the simulation's first step
+    /// (momentum units; F·dt per contact and step, as [`Flows::impulse`]).
+    pub fn wall_impulse(&self) -> [Vec3; 2] {
+        std::array::from_fn(|g| Vec3::from_fn(|k, _| float(self.flows.impulse[g][k])))
+    }
+
     /// The ledgers from `before` to this reading (of the same simulation, later).
     pub fn since(&self, before: &Reading) -> LedgerRow {
         let (a, b) = (before, self);

@@ -63,7 +63,19 @@ pub fn run_with_saves(
     end_step: u64,
     save_every: u64,
 ) -> verdem::run::RunSummary {
-    let opts = verdem::run::RunOptions {
+    let opts = run_options(dir, name, end_step, save_every);
+    verdem::run::run(engine, &opts, false).expect("run")
+}
+
+/// The options of a run `name` in `dir` to `end_step` with a save every `save_every` steps, no
+/// checkpoints and no progress bar.
+pub fn run_options(
+    dir: &Path,
+    name: &str,
+    end_step: u64,
+    save_every: u64,
+) -> verdem::run::RunOptions {
+    verdem::run::RunOptions {
         end_step,
         save_every,
         checkpoint_every: 0,
@@ -74,8 +86,7 @@ pub fn run_with_saves(
         write_saves: true,
         vtk: false,
         stop: None,
-    };
-    verdem::run::run(engine, &opts, false).expect("run")
+    }
 }
 
 /// The diagnostics table of a run resumed from a checkpoint (`resumed`) against the same run

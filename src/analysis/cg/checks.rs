@@ -185,7 +185,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     };
     let tau_se = block_core(&|c| c[col("shear_xz")]);
     let source = if p.wall_force_every_step {
-        "wall forces: every step's, averaged over each save's interval"
+        "wall forces: every step's mean over the saves' intervals"
     } else {
         "wall forces: at the saves"
     };
