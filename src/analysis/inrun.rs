@@ -24,7 +24,7 @@ use crate::analysis::{Limit, Verdict};
 use crate::case::Case;
 use crate::contact::PairInput;
 use crate::run::Observer;
-use crate::state::{Domain, Snapshot};
+use crate::state::{Domain, SampledContact, Snapshot};
 use crate::step::Engine;
 use crate::Vec3;
 
@@ -114,7 +114,7 @@ pub struct Inrun {
     impulse: Vec<[Vec3; 2]>,
     impulse_steps: Vec<u64>,
     /// The step the engine was last observed at and the walls' impulse since its first step
-    /// there ([`crate::step::Reading::wall_impulse`]).
+    /// there ([`Engine::wall_impulse`]).
     mark: Option<(u64, [Vec3; 2])>,
     /// The contact stress of the sample under way.
     scratch: Raw,
@@ -202,11 +202,11 @@ impl Inrun {
     /// the bin of its step: the contact stress and wall forces, and the particle fields when
     /// `particles`. Samples must come in the order of their steps, each in (`from`, `to`].
     pub fn sample(&mut self, snap: &Snapshot, particles: bool) {
-        let b = self.bin_of(snap.step);
-        let p = &snap.particles;
-        let (grid, kernel, area, density) = (&self.grid, self.kernel, self.area, self.density);
-        let unit = &mut self.bins[b];
         if particles {
+            let b = self.bin_of(snap.step);
+            let p = &snap.particles;
+            let (grid, kernel, area, density) = (&self.grid, self.kernel, self.area, self.density);
+            let unit = &mut self.bins[b];
             for i in self.walls..p.x.len() {
                 unit.sum
                     .add_particle(p.x[i].z, p.v[i], p.radius[i], density, grid, kernel, area);
@@ -218,37 +218,43 @@ impl Inrun {
                 .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
                 .sum();
         }
+        self.sample_contacts(snap.step, &snap.sampled_contacts());
+    }
+
+    /// Adds the contacts alive at `step` (in the window; in the order of a snapshot's) to the bin
+    /// of the step: their contact stress, and the force of those with a wall sphere on its wall.
+    pub fn sample_contacts(&mut self, step: u64, contacts: &[SampledContact]) {
+        let b = self.bin_of(step);
+        let (grid, kernel, area) = (&self.grid, self.kernel, self.area);
         self.scratch.contact.fill(Default::default());
         let mid = 0.5 * (self.domain.lo.z + self.domain.hi.z);
-        for c in &snap.contacts {
-            let (a, o) = (c.p as usize, c.i as usize);
-            let (wall_a, wall_o) = (a < self.walls, o < self.walls);
+        for c in contacts {
+            let (wall_a, wall_o) = (c.p < self.walls as u32, c.i < self.walls as u32);
             if wall_a && wall_o {
                 continue;
             }
             // The contact point exactly as the force pass and the .fstat rows have it.
             let Some(g) = (PairInput::at_rest(
-                self.domain.min_image(p.x[a] - p.x[o]),
-                p.radius[a],
-                p.radius[o],
+                self.domain.min_image(c.x[0] - c.x[1]),
+                c.radius[0],
+                c.radius[1],
             ))
             .kinematics() else {
                 continue;
             };
-            let point = p.x[a] + g.arm_p;
-            // As `verdem cg`: f on the lower-indexed free particle i, the branch from the
-            // partner's centre (free–free) or from the contact point (free–wall) to i.
-            let (i, f, start) = match (wall_a, wall_o) {
-                (false, false) => (a, c.force.f, p.x[o]),
-                (false, true) => (a, c.force.f, point),
-                _ => (o, -c.force.f, point),
+            let point = c.x[0] + g.arm_p;
+            // As `verdem cg`: f on the lower-indexed free particle, the branch from the
+            // partner's centre (free–free) or from the contact point (free–wall) to it.
+            let (x, f, start) = match (wall_a, wall_o) {
+                (false, false) => (c.x[0], c.force.f, c.x[1]),
+                (false, true) => (c.x[0], c.force.f, point),
+                _ => (c.x[1], -c.force.f, point),
             };
-            let branch = self.domain.min_image(p.x[i] - start);
-            self.scratch
-                .add_contact(p.x[i].z, branch, f, grid, kernel, area);
+            let branch = self.domain.min_image(x - start);
+            self.scratch.add_contact(x.z, branch, f, grid, kernel, area);
             if wall_a || wall_o {
-                let w = if wall_a { a } else { o };
-                self.wall[b][usize::from(p.x[w].z > mid)] -= f;
+                let w = if wall_a { c.x[0] } else { c.x[1] };
+                self.wall[b][usize::from(w.z > mid)] -= f;
             }
         }
         let unit = &mut self.bins[b];
@@ -287,13 +293,13 @@ impl Inrun {
     /// Books the walls' impulse since the engine was last observed into the bin of its
     /// current step, and marks that step.
     fn book_impulse(&mut self, engine: &dyn Engine) {
-        let reading = engine.ledger();
-        let now = (reading.step, reading.wall_impulse());
+        let now = (engine.state().step, engine.wall_impulse());
         if let Some((before, at_before)) = self.mark {
             if now.0 > before {
                 let b = self.bin_of(now.0);
+                let dt = engine.params().dt;
                 for g in 0..2 {
-                    self.impulse[b][g] += (now.1[g] - at_before[g]) / reading.dt;
+                    self.impulse[b][g] += (now.1[g] - at_before[g]) / dt;
                 }
                 self.impulse_steps[b] += now.0 - before;
             }
@@ -425,8 +431,12 @@ impl Observer for Inrun {
         if step == self.sampling.from {
             return;
         }
-        let particles = step.is_multiple_of(self.sampling.particle_every);
-        self.sample(&engine.snapshot(), particles);
+        // A particle sample needs every particle; a contact sample only the contacts.
+        if step.is_multiple_of(self.sampling.particle_every) {
+            self.sample(&engine.snapshot(), true);
+        } else {
+            self.sample_contacts(step, &engine.contact_sample());
+        }
     }
 }
 

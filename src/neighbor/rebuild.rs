@@ -93,7 +93,9 @@ pub struct Flags {
     /// Whether each particle is quiet: its force and torque slots hold zero and its velocities
     /// have absorbed a +0 kick (no −0 component), so that a free flight changes neither and only
     /// drifts it. A prescribed particle is marked quiet at its first particle pass: it has no
-    /// kick. Cleared at every build and at the start of every run.
+    /// kick. Cleared at every build: a restore or a first force evaluation, the only changes to
+    /// velocities and forces from outside a run, each rebuild first, so the flags hold across
+    /// runs.
     pub quiet: Vec<bool>,
     /// Speed class at the last build: 1 for the fast particles (faster than [`SLOW_FRACTION`]
     /// of the fastest free particle, and all prescribed ones), 0 for the others.

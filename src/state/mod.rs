@@ -7,7 +7,7 @@ pub mod tally;
 
 pub use domain::Domain;
 pub use history::History;
-pub use snapshot::{Contact, PairForce, Snapshot};
+pub use snapshot::{Contact, PairForce, SampledContact, Snapshot};
 pub use tally::Tally;
 
 use crate::Vec3;

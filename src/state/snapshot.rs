@@ -39,3 +39,34 @@ pub struct Snapshot {
     pub particles: Particles,
     pub contacts: Vec<Contact>,
 }
+
+/// A contact as a sample of the contact stress needs it: the original indices `p < i`, the
+/// force of its last evaluation (on P), and the positions (length) and radii of P and I.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampledContact {
+    pub p: u32,
+    pub i: u32,
+    pub force: PairForce,
+    pub x: [Vec3; 2],
+    pub radius: [f64; 2],
+}
+
+impl Snapshot {
+    /// The contacts of the snapshot as samples, in its order.
+    pub fn sampled_contacts(&self) -> Vec<SampledContact> {
+        let p = &self.particles;
+        self.contacts
+            .iter()
+            .map(|c| {
+                let (a, o) = (c.p as usize, c.i as usize);
+                SampledContact {
+                    p: c.p,
+                    i: c.i,
+                    force: c.force,
+                    x: [p.x[a], p.x[o]],
+                    radius: [p.radius[a], p.radius[o]],
+                }
+            })
+            .collect()
+    }
+}

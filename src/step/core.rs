@@ -10,7 +10,7 @@ use super::guard::Failure;
 use crate::case::Guard;
 use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
 use crate::neighbor::NeighborBuilder;
-use crate::state::{Contact, Domain, History, Particles, Snapshot};
+use crate::state::{Contact, Domain, History, Particles, SampledContact, Snapshot};
 use crate::team::{Crew, Shared};
 use crate::Vec3;
 
@@ -84,6 +84,11 @@ pub struct Core<H> {
     /// The ledgers' flows over every step run so far ([`super::Engine::ledger`]).
     pub(super) flows: super::Flows,
     pub(super) work: Workspace,
+    /// The run guard's energy of the state at the end of the last [`super::Engine::advance`]
+    /// and its step: the next call starts its balance from it. Forgotten by a rebuild from
+    /// outside a run (which every restore and first force evaluation makes) and by a change of
+    /// the parameters.
+    pub(super) energy_at: Option<(u64, super::energy::Energy)>,
 }
 
 impl<H: History> Core<H> {
@@ -141,6 +146,7 @@ impl<H: History> Core<H> {
                 plan: Plan::new(threads),
                 flags: Flags::default(),
             },
+            energy_at: None,
         }
     }
 
@@ -157,6 +163,7 @@ impl<H: History> Core<H> {
     /// Re-orders the particles and rebuilds the pair list on this thread, keeping every
     /// contact's history.
     pub fn rebuild(&mut self) {
+        self.energy_at = None;
         let domain = self.state.domain.clone();
         let start = std::time::Instant::now();
         let list = Shared::new(self.list_state());
@@ -197,6 +204,28 @@ impl<H: History> Core<H> {
     }
 
     /// The state in canonical order (allocates; for saves, hashes and checkpoints).
+    /// The active contacts as samples ([`SampledContact`]), sorted by `(p, i)` as a
+    /// snapshot's: a pass over the pair list, without copying every particle.
+    pub fn contact_sample(&self) -> Vec<SampledContact> {
+        let (s, pairs) = (&self.state, &self.pairs);
+        let pt = &s.particles;
+        let mut contacts: Vec<SampledContact> = (0..pairs.list.p.len())
+            .filter(|&k| pairs.active[k])
+            .map(|k| {
+                let (a, o) = (pairs.list.p[k] as usize, pairs.list.i[k] as usize);
+                SampledContact {
+                    p: s.id[a],
+                    i: s.id[o],
+                    force: pairs.out[k],
+                    x: [pt.x[a], pt.x[o]],
+                    radius: [pt.radius[a], pt.radius[o]],
+                }
+            })
+            .collect();
+        contacts.sort_unstable_by_key(|c| key(c.p, c.i));
+        contacts
+    }
+
     pub fn snapshot(&self) -> Snapshot {
         let s = &self.state;
         let n = s.particles.len();
@@ -205,18 +234,19 @@ impl<H: History> Core<H> {
             pos[id as usize] = a;
         }
         let src = &s.particles;
-        let mut particles = Particles::default();
-        for &a in &pos {
-            particles.x.push(src.x[a]);
-            particles.v.push(src.v[a]);
-            particles.w.push(src.w[a]);
-            particles.radius.push(src.radius[a]);
-            particles.inv_mass.push(src.inv_mass[a]);
-            particles.inv_inertia.push(src.inv_inertia[a]);
-            particles.motion.push(src.motion[a]);
-            particles.f.push(src.f[a]);
-            particles.t.push(src.t[a]);
-        }
+        let by_id = |v: &[Vec3]| -> Vec<Vec3> { pos.iter().map(|&a| v[a]).collect() };
+        let scalar_by_id = |v: &[f64]| -> Vec<f64> { pos.iter().map(|&a| v[a]).collect() };
+        let particles = Particles {
+            x: by_id(&src.x),
+            v: by_id(&src.v),
+            w: by_id(&src.w),
+            radius: scalar_by_id(&src.radius),
+            inv_mass: scalar_by_id(&src.inv_mass),
+            inv_inertia: scalar_by_id(&src.inv_inertia),
+            motion: pos.iter().map(|&a| src.motion[a]).collect(),
+            f: by_id(&src.f),
+            t: by_id(&src.t),
+        };
         let pairs = &self.pairs;
         let mut contacts: Vec<Contact> = (0..pairs.list.p.len())
             .filter(|&k| pairs.active[k])

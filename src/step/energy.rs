@@ -162,6 +162,11 @@ pub struct Flows {
 }
 
 impl Flows {
+    /// The impulse the free particles gave wall group 0 and 1 (momentum units; [`Flows::impulse`]).
+    pub fn wall_impulse(&self) -> [Vec3; 2] {
+        std::array::from_fn(|g| Vec3::from_fn(|k, _| float(self.impulse[g][k])))
+    }
+
     /// Adds `other`'s flows (integer sums: the same in any order).
     pub fn add(&mut self, other: &Flows) {
         self.wall_work += other.wall_work;
@@ -231,12 +236,6 @@ pub struct LedgerRow {
 }
 
 impl Reading {
-    /// The impulse the free particles gave wall group 0 and 1 since the simulation's first step
-    /// (momentum units; F·dt per contact and step, as [`Flows::impulse`]).
-    pub fn wall_impulse(&self) -> [Vec3; 2] {
-        std::array::from_fn(|g| Vec3::from_fn(|k, _| float(self.flows.impulse[g][k])))
-    }
-
     /// The ledgers from `before` to this reading (of the same simulation, later).
     pub fn since(&self, before: &Reading) -> LedgerRow {
         let (a, b) = (before, self);

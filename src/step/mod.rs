@@ -42,7 +42,7 @@ use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
-use crate::state::{History, Snapshot};
+use crate::state::{History, SampledContact, Snapshot};
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
@@ -67,6 +67,12 @@ pub trait Engine: Send {
     fn counters_mut(&mut self) -> &mut StageTimes;
     /// The state in canonical order (allocates; for saves, hashes and checkpoints).
     fn snapshot(&self) -> Snapshot;
+    /// The active contacts, as [`Snapshot::contacts`] has them, with their particles' positions
+    /// and radii: a sample of the contact stress without a snapshot of every particle.
+    fn contact_sample(&self) -> Vec<SampledContact>;
+    /// The impulse the free particles gave wall group 0 and 1 over every step run so far
+    /// (momentum units; the ledger's [`Flows::impulse`]).
+    fn wall_impulse(&self) -> [Vec3; 2];
     /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
     /// carry this law's history ([`Engine::history_words`] words each).
     fn restore(&mut self, snap: &Snapshot);
@@ -103,6 +109,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         &self.core.params
     }
     fn params_mut(&mut self) -> &mut Params {
+        self.core.energy_at = None;
         &mut self.core.params
     }
     fn counters(&self) -> &StageTimes {
@@ -113,6 +120,12 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn snapshot(&self) -> Snapshot {
         self.core.snapshot()
+    }
+    fn contact_sample(&self) -> Vec<SampledContact> {
+        self.core.contact_sample()
+    }
+    fn wall_impulse(&self) -> [Vec3; 2] {
+        self.core.flows.wall_impulse()
     }
     fn restore(&mut self, snap: &Snapshot) {
         self.core.restore(snap)
@@ -154,9 +167,13 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         if steps == 0 || self.core.failure.is_some() {
             return self.core.failure.clone().map_or(Ok(()), Err);
         }
-        // The steps run in windows, each closed by the run guard's energy balance.
+        // The steps run in windows, each closed by the run guard's energy balance; the first
+        // starts from the last call's closing energy when nothing changed the state since.
         let mut left = steps;
-        let mut before = self.energy();
+        let mut before = match self.core.energy_at.take() {
+            Some((step, e)) if step == self.core.state.step => e,
+            _ => self.energy(),
+        };
         while left > 0 && self.core.failure.is_none() {
             let window = left.min(ENERGY_WINDOW);
             let supplied = match (L::TANGENTIAL, self.core.params.gravity.is_some()) {
@@ -171,6 +188,9 @@ impl<L: ContactLaw> Engine for Simulation<L> {
                 before = after;
             }
             left -= window;
+        }
+        if self.core.failure.is_none() {
+            self.core.energy_at = Some((self.core.state.step, before));
         }
         self.core.failure.clone().map_or(Ok(()), Err)
     }
@@ -301,8 +321,6 @@ impl<L: ContactLaw> Simulation<L> {
         let chunks = core.work.plan.chunks();
         let bound = core.work.moved_bound;
         let skin = core.work.builder.skin;
-        // Velocities or forces may have been set since the last run.
-        core.work.flags.quiet.fill(false);
         core.work.plan.reset_live();
         let domain = core.state.domain.clone();
         let params = &core.params;
