@@ -185,3 +185,33 @@ fn in_run_sums_of_another_sampling_are_refused() {
     taken.restore("c.ck", 40, &bytes, 0).unwrap();
     assert_eq!(taken.state(), bytes);
 }
+
+/// A checkpoint of format version 2 (an earlier verdem: no ledgers, no in-run sums) still
+/// resumes, and `verdem run` names on stderr what the resumed run lacks.
+#[test]
+fn a_checkpoint_of_format_2_resumes_naming_what_it_lacks() {
+    let corpus = root().join("tests/corpus");
+    let dir = tempfile::tempdir().unwrap();
+    let out = verdem_ok([
+        "run",
+        corpus.join("small.toml").to_str().unwrap(),
+        "--init",
+        corpus.join("small.data").to_str().unwrap(),
+        "--resume",
+        corpus.join("small.checkpoint").to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--steps",
+        "20",
+        "--quiet",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(
+            "small.checkpoint: a checkpoint of format version 2 holds no ledgers: the ledgers' \
+             flows start again at zero"
+        ),
+        "{stderr}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("resumed at step 10"));
+}

@@ -400,16 +400,16 @@ pub fn restore_run(
     match r.take(MAGIC.len()).ok() {
         Some(m) if m == MAGIC => {}
         Some(m) if m == MAGIC_V1 => bail!(
-            "{file}: checkpoint format version 1 (an earlier verdem), this verdem reads versions \
-             {WITHOUT_RECORD} and {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
+            "{file}: checkpoint format version 1 (an earlier verdem), this verdem reads version \
+             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
         ),
         _ => bail!("{file}: not a verdem checkpoint"),
     }
     let version = r.u64()?;
     if version != FORMAT_VERSION && version != WITHOUT_RECORD {
         bail!(
-            "{file}: checkpoint format version {version}, this verdem reads versions \
-             {WITHOUT_RECORD} and {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
+            "{file}: checkpoint format version {version}, this verdem reads version \
+             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
         );
     }
     let tag_len = r.u64()?;
