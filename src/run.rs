@@ -8,9 +8,10 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 
+use crate::io::checkpoint::{Ledgers, Resumed, RunRecord};
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
 use crate::io::{atomic, csv_table, mercury, vtk};
-use crate::step::{Engine, StageTimes};
+use crate::step::{Engine, Reading, StageTimes};
 
 /// Options of one run.
 #[derive(Clone, Debug)]
@@ -223,9 +224,21 @@ pub trait Observer {
     fn start(&mut self, _engine: &dyn Engine) {}
     /// Looks at the engine's current step.
     fn observe(&mut self, engine: &dyn Engine);
+    /// Everything it has gathered, as bytes its owner can restore it from: written into the
+    /// run's checkpoints, so that a resumed run's observer continues where it was.
+    fn state(&self) -> Vec<u8>;
 }
 
-/// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists.
+/// Where a run starts.
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    Fresh,
+    /// From a checkpoint at the current step, with its ledgers when it holds them.
+    Resumed(Option<&'a Ledgers>),
+}
+
+/// Runs `engine` to `opts.end_step`. `resumed` says the current step's save already exists
+/// (a resume without the checkpoint's ledgers: [`run_resumed`] has them).
 pub fn run(
     engine: &mut dyn Engine,
     opts: &RunOptions,
@@ -239,8 +252,70 @@ pub fn run_observed(
     engine: &mut dyn Engine,
     opts: &RunOptions,
     resumed: bool,
+    observer: Option<&mut dyn Observer>,
+) -> anyhow::Result<RunSummary> {
+    let start = if resumed {
+        Start::Resumed(None)
+    } else {
+        Start::Fresh
+    };
+    run_from(engine, opts, start, observer)
+}
+
+/// Continues the run `resumed` from (restored into `engine`) to `opts.end_step`, its ledgers
+/// from those of the checkpoint when it holds them, so that its diagnostics rows are those of a
+/// run never stopped; `observer` as in [`run_observed`] (restored by its owner).
+pub fn run_resumed(
+    engine: &mut dyn Engine,
+    opts: &RunOptions,
+    resumed: &Resumed,
+    observer: Option<&mut dyn Observer>,
+) -> anyhow::Result<RunSummary> {
+    run_from(
+        engine,
+        opts,
+        Start::Resumed(resumed.record.ledgers.as_ref()),
+        observer,
+    )
+}
+
+/// The ledgers' reading at the last save before a run that starts at the current step of
+/// `engine` (`start`), a save every `save_every` steps: the checkpoint's when it holds them
+/// (refused when at another step than that save's), else the current step's when it is a save,
+/// else none until the first save.
+fn reading_at_start(
+    engine: &dyn Engine,
+    start: Start<'_>,
+    save_every: u64,
+) -> anyhow::Result<Option<Reading>> {
+    let step = engine.state().step;
+    Ok(match start {
+        Start::Fresh => None,
+        Start::Resumed(Some(l)) => {
+            let last_save = step / save_every * save_every;
+            if let Some(r) = l.last_save.filter(|r| r.step != last_save) {
+                bail!(
+                    "the checkpoint's ledgers were read at the save of step {}, but with a save \
+                     every {save_every} steps the last save before step {step} is at step \
+                     {last_save}: resume with the --save-every of the run that wrote it",
+                    r.step
+                );
+            }
+            l.last_save
+        }
+        Start::Resumed(None) => (engine.state().forces_ready && step.is_multiple_of(save_every))
+            .then(|| engine.ledger()),
+    })
+}
+
+/// The run loop of [`run_observed`] and [`run_resumed`].
+fn run_from(
+    engine: &mut dyn Engine,
+    opts: &RunOptions,
+    start: Start<'_>,
     mut observer: Option<&mut dyn Observer>,
 ) -> anyhow::Result<RunSummary> {
+    let resumed = matches!(start, Start::Resumed(_));
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
@@ -264,11 +339,12 @@ pub fn run_observed(
     if let Some(o) = observer.as_deref_mut() {
         o.start(engine);
     }
-    // The ledgers' reading at the last save; a run resumed between saves has none until its
-    // first save.
-    let mut last_reading =
-        (resumed && engine.state().forces_ready && start_step.is_multiple_of(opts.save_every))
-            .then(|| engine.ledger());
+    // The ledgers' reading at the last save.
+    let mut last_reading = if opts.write_saves {
+        reading_at_start(engine, start, opts.save_every)?
+    } else {
+        None
+    };
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;
@@ -286,13 +362,7 @@ pub fn run_observed(
             kept.save = Some(save);
             saves += 1;
         }
-        if opts.checkpoint_every > 0
-            && step.is_multiple_of(opts.checkpoint_every)
-            && step != start_step
-        {
-            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
-            kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
-        }
+        // The observer looks at a step before its checkpoint, which then holds what it saw.
         if let Some(o) = observer.as_deref_mut() {
             if step != start_step && o.next_after(step - 1) == Some(step) {
                 if !engine.state().forces_ready {
@@ -300,6 +370,21 @@ pub fn run_observed(
                 }
                 o.observe(engine);
             }
+        }
+        let record = |engine: &dyn Engine, observer: Option<&dyn Observer>| RunRecord {
+            ledgers: Some(Ledgers {
+                flows: engine.flows(),
+                last_save: last_reading,
+            }),
+            observer: observer.map(Observer::state),
+        };
+        if opts.checkpoint_every > 0
+            && step.is_multiple_of(opts.checkpoint_every)
+            && step != start_step
+        {
+            let r = record(engine, observer.as_deref());
+            write_checkpoint(engine, opts, &r).map_err(|e| kept.not_written(e, &opts.out_dir))?;
+            kept.checkpoint = Some(checkpoint_path(&opts.out_dir, &opts.name));
         }
         first = false;
         if step >= opts.end_step {
@@ -310,7 +395,8 @@ pub fn run_observed(
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed))
         {
-            write_checkpoint(engine, opts).map_err(|e| kept.not_written(e, &opts.out_dir))?;
+            let r = record(engine, observer.as_deref());
+            write_checkpoint(engine, opts, &r).map_err(|e| kept.not_written(e, &opts.out_dir))?;
             break true;
         }
         let mut next = opts.end_step.min(step + 2000);
@@ -347,12 +433,18 @@ pub fn run_observed(
     })
 }
 
-fn write_checkpoint(engine: &dyn Engine, opts: &RunOptions) -> anyhow::Result<()> {
-    crate::io::checkpoint::write(
+/// Writes the run's checkpoint of the current step, with its run record `record`.
+fn write_checkpoint(
+    engine: &dyn Engine,
+    opts: &RunOptions,
+    record: &RunRecord,
+) -> anyhow::Result<()> {
+    crate::io::checkpoint::write_run(
         &checkpoint_path(&opts.out_dir, &opts.name),
         &engine.snapshot(),
         engine.params().dt,
         &opts.tag,
+        record,
     )
 }
 

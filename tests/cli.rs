@@ -288,11 +288,8 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     let diagnostics = |d: &std::path::Path| {
         std::fs::read_to_string(d.join("shear_flow_quick.diagnostics.csv")).unwrap()
     };
-    // save s is on line s + 1; the first save after the resume is save step/1000 + 1
     common::assert_resumed_diagnostics(
         &diagnostics(stopped.path()),
         &diagnostics(straight_dir.path()),
-        (step / 1000 + 2) as usize,
-        !step.is_multiple_of(1000),
     );
 }

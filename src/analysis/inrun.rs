@@ -23,6 +23,7 @@ use crate::analysis::stats::integrated_autocorrelation;
 use crate::analysis::{Limit, Verdict};
 use crate::case::Case;
 use crate::contact::PairInput;
+use crate::io::checkpoint::Reader;
 use crate::run::Observer;
 use crate::state::{Domain, SampledContact, Snapshot};
 use crate::step::Engine;
@@ -188,6 +189,11 @@ impl Inrun {
         );
         let o = CgOptions::for_case(case);
         Ok(Inrun::new(&o, &engine.state().domain, sampling)?.with_reference_tau(case.dt()))
+    }
+
+    /// When it samples.
+    pub fn sampling(&self) -> Sampling {
+        self.sampling
     }
 
     /// The same accumulator whose errors take no τ below the bumpy-shear benchmark's reference
@@ -415,9 +421,11 @@ impl Observer for Inrun {
         (next <= s.to).then_some(next)
     }
 
+    /// Marks the walls' impulse where the run starts in the window, unless a checkpoint's
+    /// sums brought their mark (the ledgers' sums continue from the checkpoint too).
     fn start(&mut self, engine: &dyn Engine) {
         let step = engine.state().step;
-        if step >= self.sampling.from && step < self.sampling.to {
+        if self.mark.is_none() && step >= self.sampling.from && step < self.sampling.to {
             self.book_impulse(engine);
         }
     }
@@ -437,6 +445,239 @@ impl Observer for Inrun {
         } else {
             self.sample_contacts(step, &engine.contact_sample());
         }
+    }
+
+    /// The sums so far ([`Inrun::restore`] reads them back). Layout (little-endian u64 and
+    /// f64): a format number, the frame as `key=value` lines ([`Inrun::frame_tag`]), the
+    /// sampling (every, particle_every, from, to), the steps per bin, the bins (each: its
+    /// particle and contact sample counts, then per grid point ν, ρ, momentum, kinetic flux and
+    /// contact stress, then the two sampled wall-force sums, the two walls' impulse sums and
+    /// the steps they cover), the trace (its length and pairs), the free particles' count and
+    /// volume, and the impulse mark (0, or 1 then its step and the two walls' impulse).
+    fn state(&self) -> Vec<u8> {
+        let mut b = Vec::new();
+        let u = |b: &mut Vec<u8>, v: u64| b.extend_from_slice(&v.to_le_bytes());
+        let f = |b: &mut Vec<u8>, v: f64| b.extend_from_slice(&v.to_le_bytes());
+        u(&mut b, STATE_FORMAT);
+        let frame = self.frame_tag();
+        u(&mut b, frame.len() as u64);
+        b.extend_from_slice(frame.as_bytes());
+        let s = self.sampling;
+        for v in [s.every, s.particle_every, s.from, s.to, self.bin_steps] {
+            u(&mut b, v);
+        }
+        u(&mut b, self.bins.len() as u64);
+        for (k, (unit, wall)) in self.bins.iter().zip(&self.wall).enumerate() {
+            u(&mut b, unit.particle_samples);
+            u(&mut b, unit.contact_samples);
+            let sum = &unit.sum;
+            for k in 0..self.grid.n {
+                let values = [sum.nu[k], sum.rho[k]]
+                    .into_iter()
+                    .chain(sum.momentum[k].iter().copied())
+                    .chain(sum.flux[k].iter().copied())
+                    .chain(sum.contact[k].iter().copied());
+                for v in values {
+                    f(&mut b, v);
+                }
+            }
+            for v in wall.iter().chain(&self.impulse[k]).flat_map(|w| w.iter()) {
+                f(&mut b, *v);
+            }
+            u(&mut b, self.impulse_steps[k]);
+        }
+        u(&mut b, self.trace.len() as u64);
+        for v in self.trace.iter().flatten() {
+            f(&mut b, *v);
+        }
+        u(&mut b, self.free as u64);
+        f(&mut b, self.free_volume);
+        match self.mark {
+            None => u(&mut b, 0),
+            Some((step, impulse)) => {
+                u(&mut b, 1);
+                u(&mut b, step);
+                for v in impulse.iter().flat_map(|w| w.iter()) {
+                    f(&mut b, *v);
+                }
+            }
+        }
+        b
+    }
+}
+
+/// The format number of [`Inrun`]'s state in a checkpoint.
+const STATE_FORMAT: u64 = 1;
+
+impl Inrun {
+    /// What the sums depend on besides the sampling, as `key=value` lines: the slices, the
+    /// kernel, the wall spheres, the density and the area (f64 written to round-trip).
+    fn frame_tag(&self) -> String {
+        let g = &self.grid;
+        format!(
+            "slices={}\nz0={:?}\nz1={:?}\nkernel={:?}\nwall spheres={}\ndensity={:?}\narea={:?}",
+            g.n, g.z0, g.z1, self.kernel, self.walls, self.density, self.area
+        )
+    }
+
+    /// Continues from the sums `bytes` ([`Observer::state`]) that a checkpoint of the same run
+    /// at step `step` holds, from byte `at` of `file`: afterwards the accumulator is the one the
+    /// run that wrote the checkpoint had there. Refused, naming the file and the field, when
+    /// they were taken in another frame (slices, kernel, wall spheres, density, area), at other
+    /// intervals or over another window than this run's (this run's window starts at the resume
+    /// when it is past the checkpoint's start), or are malformed.
+    pub fn restore(
+        &mut self,
+        file: &str,
+        at: usize,
+        bytes: &[u8],
+        step: u64,
+    ) -> anyhow::Result<()> {
+        let mut r = Reader::new(file, bytes, at, "in-run sums of the checkpoint");
+        let what = |w: &'static str| move || format!("in-run sums: {w}");
+        let format = r.u64()?;
+        if format != STATE_FORMAT {
+            bail!(
+                "{file}: byte {at}: in-run sums of format {format}, this verdem reads format \
+                 {STATE_FORMAT}"
+            );
+        }
+        let len = r.count(bytes.len(), &what("frame length"))?;
+        let frame = String::from_utf8_lossy(r.take(len)?).to_string();
+        let ours = self.frame_tag();
+        if frame != ours {
+            let differs: Vec<String> = ours
+                .lines()
+                .zip(frame.lines().chain(std::iter::repeat("(none)")))
+                .filter(|(a, b)| a != b)
+                .map(|(a, b)| {
+                    let (key, value) = a.split_once('=').unwrap_or((a, ""));
+                    let theirs = b.split_once('=').map_or(b, |(_, v)| v);
+                    format!("{key} {theirs}, this run's {value}")
+                })
+                .collect();
+            let differs = if differs.is_empty() {
+                vec![format!("frame {frame:?}, this run's {ours:?}")]
+            } else {
+                differs
+            };
+            bail!(
+                "{file}: refused, in-run sums of another coarse-graining: {}",
+                differs.join("; ")
+            );
+        }
+        let mut taken = [0u64; 5];
+        for v in &mut taken {
+            *v = r.u64()?;
+        }
+        let [every, particle_every, from, to, bin_steps] = taken;
+        let s = self.sampling;
+        let mut differs = Vec::new();
+        if every != s.every {
+            differs.push(format!(
+                "contact samples every {every} steps, this run every {} (--inrun-every)",
+                s.every
+            ));
+        }
+        if particle_every != s.particle_every {
+            differs.push(format!(
+                "particle samples every {particle_every} steps, this run every {} \
+                 (--inrun-particle-every)",
+                s.particle_every
+            ));
+        }
+        if to != s.to {
+            differs.push(format!(
+                "samples up to step {to}, this run up to step {} (--steps)",
+                s.to
+            ));
+        }
+        if from.max(step) != s.from {
+            differs.push(format!(
+                "samples after step {from}, this run after step {} (the saves' second half)",
+                s.from
+            ));
+        }
+        if !differs.is_empty() {
+            bail!(
+                "{file}: refused, in-run sums taken otherwise than this run takes them: {}; \
+                 resume as the run that wrote it, or with --inrun-every 0",
+                differs.join("; ")
+            );
+        }
+        if bin_steps == 0 || !bin_steps.is_multiple_of(particle_every) {
+            bail!(
+                "{file}: in-run sums: {bin_steps} steps per bin, not a multiple of the particle \
+                 samples' {particle_every}"
+            );
+        }
+        let n = self.grid.n;
+        let bins = r.count(MAX_BINS, &what("bin count"))?;
+        let mut units = Vec::with_capacity(bins);
+        let mut wall = Vec::with_capacity(bins);
+        let (mut impulse, mut impulse_steps) = (Vec::with_capacity(bins), Vec::with_capacity(bins));
+        for b in 0..bins {
+            let mut unit = Unit::empty(n);
+            unit.particle_samples = r.u64()?;
+            unit.contact_samples = r.u64()?;
+            let here =
+                |q: &'static str, k: usize| move || format!("in-run sums: bin {b}, point {k}: {q}");
+            let sum = &mut unit.sum;
+            for k in 0..n {
+                sum.nu[k] = r.f64(&here("nu", k))?;
+                sum.rho[k] = r.f64(&here("rho", k))?;
+                sum.momentum[k] = r.vec(&here("momentum", k))?;
+                for (q, m) in [
+                    ("kinetic flux", &mut sum.flux[k]),
+                    ("contact stress", &mut sum.contact[k]),
+                ] {
+                    for v in m.iter_mut() {
+                        *v = r.f64(&here(q, k))?;
+                    }
+                }
+            }
+            let mut w = [Vec3::zeros(); 2];
+            for (g, wg) in w.iter_mut().enumerate() {
+                *wg = r.vec(&|| format!("in-run sums: bin {b}: force on wall {g}"))?;
+            }
+            let mut j = [Vec3::zeros(); 2];
+            for (g, jg) in j.iter_mut().enumerate() {
+                *jg = r.vec(&|| format!("in-run sums: bin {b}: impulse on wall {g}"))?;
+            }
+            impulse_steps.push(r.u64()?);
+            units.push(unit);
+            wall.push(w);
+            impulse.push(j);
+        }
+        let len = r.count(TRACE_SAMPLES, &what("trace length"))?;
+        let mut trace = Vec::with_capacity(len);
+        for _ in 0..len {
+            trace.push([r.f64(&what("trace"))?, r.f64(&what("trace"))?]);
+        }
+        let free = r.count(usize::MAX, &what("free particles"))?;
+        let free_volume = r.f64(&what("free volume"))?;
+        let mark = match r.u64()? {
+            0 => None,
+            1 => {
+                let step = r.u64()?;
+                let bottom = r.vec(&what("walls' impulse at the mark"))?;
+                let top = r.vec(&what("walls' impulse at the mark"))?;
+                Some((step, [bottom, top]))
+            }
+            flag => bail!("{file}: in-run sums: impulse mark flag {flag}, expected 0 or 1"),
+        };
+        r.end()?;
+        self.sampling.from = from;
+        self.bin_steps = bin_steps;
+        self.bins = units;
+        self.wall = wall;
+        self.impulse = impulse;
+        self.impulse_steps = impulse_steps;
+        self.mark = mark;
+        self.trace = trace;
+        self.free = free;
+        self.free_volume = free_volume;
+        Ok(())
     }
 }
 

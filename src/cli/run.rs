@@ -73,14 +73,21 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     }
     print_contact_summary(&case);
     let tag = checkpoint::tag(&case);
-    if let Some(ck) = &a.resume {
-        checkpoint::read(ck, engine.as_mut(), &tag)?;
-        println!(
-            "resumed at step {} (t = {})",
-            engine.state().step,
-            engine.state().time
-        );
-    }
+    let resumed = match &a.resume {
+        Some(ck) => {
+            let r = checkpoint::read_run(ck, engine.as_mut(), &tag)?;
+            for lack in r.lacks() {
+                eprintln!("warning: {}: {lack}", ck.display());
+            }
+            println!(
+                "resumed at step {} (t = {})",
+                engine.state().step,
+                engine.state().time
+            );
+            Some((ck.as_path(), r))
+        }
+        None => None,
+    };
     let end_step = a.steps.unwrap_or(case.run.steps);
     if end_step < engine.state().step {
         anyhow::bail!(
@@ -131,17 +138,16 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             &case,
             engine.as_ref(),
             &opts,
-            a.resume.is_some(),
+            resumed.as_ref(),
         )?
     } else {
         None
     };
-    let s = run::run_observed(
-        engine.as_mut(),
-        &opts,
-        a.resume.is_some(),
-        inrun.as_mut().map(|i| i as &mut dyn run::Observer),
-    )?;
+    let observer = inrun.as_mut().map(|i| i as &mut dyn run::Observer);
+    let s = match &resumed {
+        Some((_, r)) => run::run_resumed(engine.as_mut(), &opts, r, observer)?,
+        None => run::run_observed(engine.as_mut(), &opts, false, observer)?,
+    };
     let limit = engine.params().guard.overlap;
     if s.deepest_overlap > OVERLAP_WARNING * limit {
         eprintln!(
@@ -244,13 +250,15 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
 
 /// The in-run averaging of a bumpy-shear run, over the steps of the saves `verdem cg` takes by
 /// default (the second half of the run's saves), or `None` with `--inrun-every 0`. `every` and
-/// `particle_every` are the command line's intervals, when given.
+/// `particle_every` are the command line's intervals, when given. A run `resumed` from a
+/// checkpoint continues the sums it holds; one that holds none (warned on stderr) starts them at
+/// the resume.
 fn in_run(
     (every, particle_every): (Option<u64>, Option<u64>),
     case: &Case,
     engine: &dyn Engine,
     opts: &RunOptions,
-    resumed: bool,
+    resumed: Option<&(&Path, checkpoint::Resumed)>,
 ) -> anyhow::Result<Option<Inrun>> {
     let start = engine.state().step;
     // Intervals in contact durations (docs/statistics.md).
@@ -259,7 +267,7 @@ fn in_run(
         return Ok(None);
     }
     // The saves cg averages by default: the second half of those the folder will hold.
-    let first = if resumed {
+    let first = if resumed.is_some() {
         run::saves_of(&opts.out_dir, &opts.name)?
             .first()
             .copied()
@@ -267,13 +275,19 @@ fn in_run(
     } else {
         start.div_ceil(opts.save_every)
     };
-    Ok(Some(Inrun::for_run(
-        case,
-        engine,
-        opts,
-        (every, particle_every),
-        first,
-    )?))
+    let mut inrun = Inrun::for_run(case, engine, opts, (every, particle_every), first)?;
+    if let Some((ck, r)) = resumed {
+        let file = ck.display().to_string();
+        match &r.record.observer {
+            Some(sums) => inrun.restore(&file, r.observer_at, sums, start)?,
+            None if inrun.sampling().from == start => eprintln!(
+                "warning: {file}: the checkpoint holds no in-run sums: the in-run profiles cover \
+                 only the steps after the resume (step {start})"
+            ),
+            None => {}
+        }
+    }
+    Ok(Some(inrun))
 }
 
 /// Draws the last save in the output folder as `NAME.particles.png` (none when the folder has

@@ -1,6 +1,9 @@
 //! Binary checkpoints: everything a step needs to continue bit for bit (positions, velocities,
-//! spins, the forces of the current step, and each contact's history and force), written
-//! atomically. The pair list itself is rebuilt on resume; results do not depend on when it is.
+//! spins, the forces of the current step, and each contact's history and force), and what the
+//! run loop needs to write the same files as a run never stopped (the ledgers' flows and their
+//! reading at the last save, and the state of its observer, the in-run averaging), written
+//! atomically in one file. The pair list itself is rebuilt on resume; results do not depend on
+//! when it is.
 
 use std::path::Path;
 
@@ -8,15 +11,75 @@ use anyhow::{bail, Context};
 
 use crate::contact::PairForce;
 use crate::state::{Contact, Snapshot};
-use crate::step::Engine;
+use crate::step::{Engine, Flows, Reading};
 use crate::Vec3;
 
 /// The first 8 bytes of every checkpoint; the format version follows.
 const MAGIC: &[u8; 8] = b"VERDEMCK";
 /// The first 8 bytes of the checkpoints of format version 1, which had no version field.
 const MAGIC_V1: &[u8; 8] = b"VERDEMC1";
-/// The layout this verdem writes and reads.
-pub const FORMAT_VERSION: u64 = 2;
+/// The layout this verdem writes; it also reads version 2, which had no run record
+/// ([`RunRecord`]).
+pub const FORMAT_VERSION: u64 = 3;
+
+/// The last format version without a run record.
+const WITHOUT_RECORD: u64 = 2;
+
+/// What a run keeps beside the state, written with it from format version 3 on, so that a
+/// resumed run writes the same diagnostics and in-run profiles as a run never stopped.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunRecord {
+    /// The ledgers; `None` in a checkpoint written without them (not by a run).
+    pub ledgers: Option<Ledgers>,
+    /// The state of the run loop's observer ([`crate::run::Observer::state`]: the in-run
+    /// averaging), opaque here; `None` for a run without one.
+    pub observer: Option<Vec<u8>>,
+}
+
+/// The ledgers of a run at its checkpoint.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ledgers {
+    /// The flows accumulated from the simulation's start to the checkpoint's step
+    /// ([`Engine::flows`]).
+    pub flows: Flows,
+    /// The ledgers' reading at the run's last save at or before the checkpoint's step, from
+    /// which its next save's ledger row is taken (`None` before the run's first save).
+    pub last_save: Option<Reading>,
+}
+
+/// A checkpoint restored into an engine: its step, its format version and its run record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resumed {
+    pub step: u64,
+    pub version: u64,
+    pub record: RunRecord,
+    /// Where the run record's observer state starts in the file (byte), for its messages.
+    pub observer_at: usize,
+}
+
+impl Resumed {
+    /// What the checkpoint lacks of its run record, one sentence each (for the user; the
+    /// observer's state is its owner's to judge).
+    pub fn lacks(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.record.ledgers.is_none() {
+            let why = if self.version <= WITHOUT_RECORD {
+                format!(
+                    "a checkpoint of format version {} holds no ledgers",
+                    self.version
+                )
+            } else {
+                "the checkpoint was written without the ledgers (not by a run)".into()
+            };
+            out.push(format!(
+                "{why}: the ledgers' flows start again at zero, and when the resume is \
+                 between saves the first save after it has an empty ledger row (its \
+                 diagnostics columns are whole)"
+            ));
+        }
+        out
+    }
+}
 
 /// The tag of a run of `case`: what a checkpoint must share with the case it resumes, as
 /// `key=value` lines (the case's name and its tangential convention, which fixes what a
@@ -31,11 +94,27 @@ pub fn tag(case: &crate::case::Case) -> String {
     )
 }
 
-/// Writes a checkpoint of a state advanced with time step `dt`; `tag` identifies the case
-/// (checked on resume; see [`tag`]). Layout (little-endian): magic, format version, tag, step,
-/// time, dt, particle count, history words per contact, then x v w f t of every particle, the
-/// contact count and each contact (p, i as u32, its history words, f, torques, fn).
+/// Writes a checkpoint of a state advanced with time step `dt` without a run record (its
+/// resume starts the ledgers again: [`Resumed::lacks`]); `tag` identifies the case (checked on
+/// resume; see [`tag`]).
 pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result<()> {
+    write_run(path, core, dt, tag, &RunRecord::default())
+}
+
+/// Writes a checkpoint of a state advanced with time step `dt` and the run record `record`;
+/// `tag` identifies the case (checked on resume; see [`tag`]). Layout (little-endian): magic,
+/// format version, tag, step, time, dt, particle count, history words per contact, then x v w
+/// f t of every particle, the contact count and each contact (p, i as u32, its history words,
+/// f, torques, fn); then the run record: a flag (0 or 1) and the ledgers (the flows, a flag and
+/// the reading at the last save: [`put_flows`], [`put_reading`]), a flag and the observer's
+/// state (its length and bytes).
+pub fn write_run(
+    path: &Path,
+    core: &Snapshot,
+    dt: f64,
+    tag: &str,
+    record: &RunRecord,
+) -> anyhow::Result<()> {
     let mut b = Vec::new();
     b.extend_from_slice(MAGIC);
     b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -76,29 +155,99 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
     }
+    let flag = |b: &mut Vec<u8>, set: bool| b.extend_from_slice(&u64::from(set).to_le_bytes());
+    flag(&mut b, record.ledgers.is_some());
+    if let Some(l) = &record.ledgers {
+        put_flows(&mut b, &l.flows);
+        flag(&mut b, l.last_save.is_some());
+        if let Some(r) = &l.last_save {
+            put_reading(&mut b, r);
+        }
+    }
+    flag(&mut b, record.observer.is_some());
+    if let Some(o) = &record.observer {
+        b.extend_from_slice(&(o.len() as u64).to_le_bytes());
+        b.extend_from_slice(o);
+    }
     Ok(crate::io::atomic::write(path, &b)?)
 }
 
-struct Reader<'a> {
-    b: &'a [u8],
-    at: usize,
-    file: String,
+/// Appends `flows`: the walls' and gravity's work, the three dissipations, the impulses of the
+/// two wall groups (i128 fixed point, [`Flows`]).
+fn put_flows(b: &mut Vec<u8>, f: &Flows) {
+    let words = [f.wall_work, f.gravity_work]
+        .into_iter()
+        .chain(f.dissipated)
+        .chain(f.impulse.into_iter().flatten());
+    for w in words {
+        b.extend_from_slice(&w.to_le_bytes());
+    }
 }
 
-impl Reader<'_> {
-    fn take(&mut self, n: usize) -> anyhow::Result<&[u8]> {
+/// Appends the reading `r`: step, dt, whether the law splits its dissipation (0 or 1), its
+/// flows, the translational, rotational, elastic and potential energies, the momentum, the
+/// force on the two wall groups (i128 fixed point) and the weight (f64).
+fn put_reading(b: &mut Vec<u8>, r: &Reading) {
+    b.extend_from_slice(&r.step.to_le_bytes());
+    b.extend_from_slice(&r.dt.to_le_bytes());
+    b.extend_from_slice(&u64::from(r.splits).to_le_bytes());
+    put_flows(b, &r.flows);
+    let words = [r.trans, r.rot, r.elastic, r.potential]
+        .into_iter()
+        .chain(r.momentum)
+        .chain(r.wall_force.into_iter().flatten());
+    for w in words {
+        b.extend_from_slice(&w.to_le_bytes());
+    }
+    for k in 0..3 {
+        b.extend_from_slice(&r.weight[k].to_le_bytes());
+    }
+}
+
+/// A little-endian reader of a binary file (a checkpoint, or a section of one) whose errors
+/// name the file and the byte.
+pub struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+    /// Where `b` starts in the file (byte).
+    base: usize,
+    file: String,
+    /// What `b` is, for the messages ("checkpoint").
+    what: &'static str,
+}
+
+impl<'a> Reader<'a> {
+    /// A reader of `bytes`, which start at byte `base` of `file` and are a `what`.
+    pub fn new(file: &str, bytes: &'a [u8], base: usize, what: &'static str) -> Reader<'a> {
+        Reader {
+            b: bytes,
+            at: 0,
+            base,
+            file: file.to_string(),
+            what,
+        }
+    }
+
+    /// Where the reader is in the file (byte).
+    pub fn at(&self) -> usize {
+        self.base + self.at
+    }
+
+    /// The next `n` bytes.
+    pub fn take(&mut self, n: usize) -> anyhow::Result<&'a [u8]> {
         if n > self.b.len() - self.at {
             bail!(
-                "{}: checkpoint truncated at byte {} (of {}; {n} more expected)",
+                "{}: {} truncated at byte {} (of {}; {n} more expected)",
                 self.file,
-                self.at,
-                self.b.len()
+                self.what,
+                self.at(),
+                self.base + self.b.len()
             );
         }
         self.at += n;
         Ok(&self.b[self.at - n..self.at])
     }
-    fn u64(&mut self) -> anyhow::Result<u64> {
+    pub fn u64(&mut self) -> anyhow::Result<u64> {
         let mut w = [0; 8];
         w.copy_from_slice(self.take(8)?);
         Ok(u64::from_le_bytes(w))
@@ -108,61 +257,159 @@ impl Reader<'_> {
         w.copy_from_slice(self.take(4)?);
         Ok(u32::from_le_bytes(w))
     }
+    fn i128(&mut self) -> anyhow::Result<i128> {
+        let mut w = [0; 16];
+        w.copy_from_slice(self.take(16)?);
+        Ok(i128::from_le_bytes(w))
+    }
+    /// A count of at most `most`, or an error naming `what` and where it is.
+    pub fn count(&mut self, most: usize, what: &dyn Fn() -> String) -> anyhow::Result<usize> {
+        let at = self.at();
+        let n = self.u64()?;
+        match usize::try_from(n) {
+            Ok(n) if n <= most => Ok(n),
+            _ => bail!(
+                "{}: byte {at}: {} is {n}, more than {most}",
+                self.file,
+                what()
+            ),
+        }
+    }
+    /// A flag, 0 or 1, or an error naming `what` and where it is.
+    pub fn flag(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<bool> {
+        let at = self.at();
+        match self.u64()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            v => bail!(
+                "{}: byte {at}: {} is {v}, neither 0 nor 1",
+                self.file,
+                what()
+            ),
+        }
+    }
     /// A finite f64, or an error naming `what` and where it is.
-    fn f64(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<f64> {
-        let at = self.at;
+    pub fn f64(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<f64> {
+        let at = self.at();
         let v = f64::from_bits(self.u64()?);
         if !v.is_finite() {
             bail!("{}: byte {at}: {} is not finite ({v})", self.file, what());
         }
         Ok(v)
     }
-    fn vec(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<Vec3> {
+    pub fn vec(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<Vec3> {
         let mut v = Vec3::zeros();
         for k in 0..3 {
             v[k] = self.f64(&|| format!("{}[{k}]", what()))?;
         }
         Ok(v)
     }
+    /// An error unless every byte has been read.
+    pub fn end(&self) -> anyhow::Result<()> {
+        if self.at != self.b.len() {
+            bail!(
+                "{}: {} trailing bytes after the {}",
+                self.file,
+                self.b.len() - self.at,
+                self.what
+            );
+        }
+        Ok(())
+    }
+    fn flows(&mut self) -> anyhow::Result<Flows> {
+        let mut f = Flows {
+            wall_work: self.i128()?,
+            gravity_work: self.i128()?,
+            ..Flows::default()
+        };
+        for d in &mut f.dissipated {
+            *d = self.i128()?;
+        }
+        for j in f.impulse.iter_mut().flatten() {
+            *j = self.i128()?;
+        }
+        Ok(f)
+    }
+    fn reading(&mut self) -> anyhow::Result<Reading> {
+        let step = self.u64()?;
+        let dt = self.f64(&|| "ledgers: dt of the last save's reading".into())?;
+        let splits = self.flag(&|| "ledgers: the last save's dissipation flag".into())?;
+        let flows = self.flows()?;
+        let mut r = Reading {
+            step,
+            dt,
+            splits,
+            flows,
+            trans: self.i128()?,
+            rot: self.i128()?,
+            elastic: self.i128()?,
+            potential: self.i128()?,
+            momentum: [0; 3],
+            wall_force: [[0; 3]; 2],
+            weight: Vec3::zeros(),
+        };
+        for m in &mut r.momentum {
+            *m = self.i128()?;
+        }
+        for f in r.wall_force.iter_mut().flatten() {
+            *f = self.i128()?;
+        }
+        r.weight = self.vec(&|| "ledgers: weight of the last save's reading".into())?;
+        Ok(r)
+    }
 }
 
 /// Restores a checkpoint into `engine` (built from the same case); returns the step it holds.
 pub fn read(path: &Path, engine: &mut dyn Engine, tag: &str) -> anyhow::Result<u64> {
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
-    restore(&path.display().to_string(), &bytes, engine, tag)
+    Ok(read_run(path, engine, tag)?.step)
 }
 
-/// Restores the checkpoint `bytes` of `file` into `engine`; returns the step it holds. A
-/// checkpoint of another format version, another case (the fields of its tag), another
-/// particle count, time step or number of history words is refused, naming every field that
-/// differs; so are a truncated file, trailing bytes, a number that is not finite and a contact
-/// whose particles are not the case's.
+/// Restores a checkpoint into `engine` (built from the same case), the ledgers' flows among
+/// it when the checkpoint holds them; returns what it holds besides ([`Resumed`]).
+pub fn read_run(path: &Path, engine: &mut dyn Engine, tag: &str) -> anyhow::Result<Resumed> {
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
+    restore_run(&path.display().to_string(), &bytes, engine, tag)
+}
+
+/// Restores the checkpoint `bytes` of `file` into `engine`; returns the step it holds.
 pub fn restore(
     file: &str,
     bytes: &[u8],
     engine: &mut dyn Engine,
     tag: &str,
 ) -> anyhow::Result<u64> {
-    let mut r = Reader {
-        b: bytes,
-        at: 0,
-        file: file.to_string(),
-    };
+    Ok(restore_run(file, bytes, engine, tag)?.step)
+}
+
+/// Restores the checkpoint `bytes` of `file` into `engine`, and the ledgers' flows when it
+/// holds them; returns its step and run record. A checkpoint of another format version than 2
+/// or 3, another case (the fields of its tag), another particle count, time step or number of
+/// history words is refused, naming every field that differs; so are a truncated file, trailing
+/// bytes, a number that is not finite, a contact whose particles are not the case's, and
+/// ledgers of another time step, of a law that splits its dissipation otherwise, or read after
+/// the checkpoint's step.
+pub fn restore_run(
+    file: &str,
+    bytes: &[u8],
+    engine: &mut dyn Engine,
+    tag: &str,
+) -> anyhow::Result<Resumed> {
+    let mut r = Reader::new(file, bytes, 0, "checkpoint");
     // A file too short for the magic is not a checkpoint either.
     match r.take(MAGIC.len()).ok() {
         Some(m) if m == MAGIC => {}
         Some(m) if m == MAGIC_V1 => bail!(
             "{file}: checkpoint format version 1 (an earlier verdem), this verdem reads version \
-             {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
+             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
         ),
         _ => bail!("{file}: not a verdem checkpoint"),
     }
     let version = r.u64()?;
-    if version != FORMAT_VERSION {
+    if version != FORMAT_VERSION && version != WITHOUT_RECORD {
         bail!(
             "{file}: checkpoint format version {version}, this verdem reads version \
-             {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
+             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
         );
     }
     let tag_len = r.u64()?;
@@ -239,14 +486,72 @@ pub fn restore(
             },
         });
     }
-    if r.at != bytes.len() {
+    let mut record = RunRecord::default();
+    let mut observer_at = bytes.len();
+    if version > WITHOUT_RECORD {
+        if r.flag(&|| "the ledgers' flag".into())? {
+            let flows = r.flows()?;
+            let last_save = if r.flag(&|| "the last save's ledgers flag".into())? {
+                let at = r.at();
+                let reading = r.reading()?;
+                if reading.step > step || reading.dt.to_bits() != dt.to_bits() {
+                    bail!(
+                        "{file}: byte {at}: ledgers: the last save's reading is at step {} with \
+                         dt {}, not at or before the checkpoint's step {step} with dt {dt}",
+                        reading.step,
+                        reading.dt
+                    );
+                }
+                Some((at, reading))
+            } else {
+                None
+            };
+            record.ledgers = Some(Ledgers {
+                flows,
+                last_save: last_save.map(|l| l.1),
+            });
+            if let Some((at, reading)) = last_save {
+                check_splits(file, at, &reading, engine)?;
+            }
+        }
+        if r.flag(&|| "the observer's flag".into())? {
+            let len = r.count(bytes.len(), &|| "the observer's state length".into())?;
+            observer_at = r.at();
+            record.observer = Some(r.take(len)?.to_vec());
+        }
+    }
+    r.end()?;
+    engine.restore(&snap);
+    if let Some(l) = &record.ledgers {
+        engine.set_flows(l.flows);
+    }
+    Ok(Resumed {
+        step: engine.state().step,
+        version,
+        record,
+        observer_at,
+    })
+}
+
+/// Refuses a last save's reading (at byte `at` of `file`) of a law that splits its dissipation
+/// otherwise than `engine`'s.
+fn check_splits(
+    file: &str,
+    at: usize,
+    reading: &Reading,
+    engine: &dyn Engine,
+) -> anyhow::Result<()> {
+    let ours = engine.ledger().splits;
+    if reading.splits != ours {
+        let says = |s: bool| if s { "splits" } else { "does not split" };
         bail!(
-            "{file}: {} trailing bytes after the checkpoint",
-            bytes.len() - r.at
+            "{file}: byte {at}: ledgers: refused, a checkpoint of another contact law: its law {} \
+             its dissipation, the case's {}",
+            says(reading.splits),
+            says(ours)
         );
     }
-    engine.restore(&snap);
-    Ok(engine.state().step)
+    Ok(())
 }
 
 /// What differs between a checkpoint's tag and the case's: field by field when both are

@@ -64,6 +64,20 @@ pub struct Pairs<H> {
     carried: Vec<H>,
     carried_out: Vec<PairForce>,
     carried_tally: Vec<Tally>,
+    /// The contacts the last rebuild closed because their particles no longer touch: each one's
+    /// index in `carried` and whether a free particle is in it.
+    dropped: Vec<(u32, bool)>,
+}
+
+impl<H> Pairs<H> {
+    /// The contacts the last rebuild closed because their particles had separated in the drift
+    /// before it (the pair pass of that step would have closed them): each one's history at its
+    /// last force evaluation and whether a free particle is in it. Valid until the next rebuild.
+    pub fn dropped(&self) -> impl Iterator<Item = (&H, bool)> + '_ {
+        self.dropped
+            .iter()
+            .map(|&(k, free)| (&self.carried[k as usize], free))
+    }
 }
 
 impl<H> Default for Pairs<H> {
@@ -77,6 +91,7 @@ impl<H> Default for Pairs<H> {
             carried: Vec::new(),
             carried_out: Vec::new(),
             carried_tally: Vec::new(),
+            dropped: Vec::new(),
         }
     }
 }
@@ -339,18 +354,28 @@ pub unsafe fn rebuild<H: History>(
 }
 
 impl<H: History> ListState<'_, H> {
-    /// Lead phase: the history of the contacts by original ids; the new memory order; room for
-    /// the permutation and the search, and the views the crew writes them through.
+    /// Lead phase: the history of the contacts by original ids, and the contacts whose particles
+    /// no longer touch ([`Pairs::dropped`]); the new memory order; room for the permutation and
+    /// the search, and the views the crew writes them through.
     fn remember_contacts(&mut self, domain: &Domain) {
         let chunks = self.plan.chunks();
         let s = &mut self.plan.scratch;
         let n = self.particles.len();
         s.old_keys.clear();
-        let list = &self.pairs.list;
+        self.pairs.dropped.clear();
+        let (list, pt) = (&self.pairs.list, &*self.particles);
         for k in 0..list.p.len() {
             if self.pairs.active[k] {
-                let (p, i) = (self.id[list.p[k] as usize], self.id[list.i[k] as usize]);
-                s.old_keys.push((key(p, i), k as u32));
+                let (a, b) = (list.p[k] as usize, list.i[k] as usize);
+                s.old_keys.push((key(self.id[a], self.id[b]), k as u32));
+                // The touching test of `sort_chunk`, on the same positions: a contact it will
+                // not carry over.
+                let sum = pt.radius[a] + pt.radius[b];
+                let touching = domain.min_image(pt.x[a] - pt.x[b]).norm_squared() < sum * sum;
+                if !touching {
+                    let free = pt.inv_mass[a] > 0.0 || pt.inv_mass[b] > 0.0;
+                    self.pairs.dropped.push((k as u32, free));
+                }
             }
         }
         s.old_keys.sort_unstable();
@@ -558,7 +583,8 @@ impl<H: History> ListState<'_, H> {
         for j in 0..pb - pa {
             let (pm, im) = (next_p[j] as usize, next_i[j] as usize);
             // A contact the particles have just left would be closed by the coming force
-            // pass; close it here, since that pass may skip pairs with a positive gap.
+            // pass; close it here, since that pass may skip pairs with a positive gap (the lead
+            // phase listed it in `Pairs::dropped`, for the step to book what it held).
             let sum = pt.radius[pm] + pt.radius[im];
             let touching = domain.min_image(pt.x[pm] - pt.x[im]).norm_squared() < sum * sum;
             if !touching {

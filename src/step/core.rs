@@ -160,8 +160,10 @@ impl<H: History> Core<H> {
         self.pairs.list.p.len()
     }
 
-    /// Re-orders the particles and rebuilds the pair list on this thread, keeping every
-    /// contact's history.
+    /// Re-orders the particles and rebuilds the pair list on this thread, keeping the history of
+    /// every contact whose particles still touch; the others are closed and listed in
+    /// [`Pairs::dropped`], for the caller that knows the law to book what they held
+    /// (`Simulation` does).
     pub fn rebuild(&mut self) {
         self.energy_at = None;
         let domain = self.state.domain.clone();

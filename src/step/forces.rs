@@ -7,7 +7,7 @@ use super::arrays::Arrays;
 use super::energy::{fixed, Flows};
 use super::guard::Breach;
 use crate::contact::{ContactLaw, Dissipated, PairInput};
-use crate::neighbor::rebuild::CLASSES;
+use crate::neighbor::rebuild::{Pairs, CLASSES};
 use crate::state::{Domain, Motion, PairForce, Tally};
 use crate::team::SharedSlice;
 use crate::Vec3;
@@ -349,11 +349,30 @@ unsafe fn opened<L: ContactLaw>(
 ) {
     let (p, i) = (s.p[k] as usize, s.i[k] as usize);
     let free = view.inv_mass[p] > 0.0 || view.inv_mass[i] > 0.0;
+    book_release(view.law, &s.history[k], free, flows);
+    forget(&mut s.history[k], &mut s.active[k]);
+}
+
+/// Books what the springs of a contact that has just opened (history `history`, its last) still
+/// held at zero overlap, stored_energy(0, h) − normal_energy(0), as released by the slider, when
+/// the law splits its dissipation and a free particle is in it (`free`).
+#[inline(always)]
+fn book_release<L: ContactLaw>(law: &L, history: &L::History, free: bool, flows: &mut Flows) {
     if L::SPLITS_DISSIPATION && free {
-        let held = view.law.stored_energy(0.0, &s.history[k]) - view.law.normal_energy(0.0);
+        let held = law.stored_energy(0.0, history) - law.normal_energy(0.0);
         flows.dissipated[2] += fixed(held);
     }
-    forget(&mut s.history[k], &mut s.active[k]);
+}
+
+/// Books, as [`opened`] does, the contacts the last pair-list rebuild closed because their
+/// particles had separated in the drift before it ([`Pairs::dropped`]): the pair pass of the
+/// same step, which would have booked them, no longer sees them active. Call right after the
+/// rebuild, in the step it ran in.
+#[cold]
+pub(super) fn book_dropped<L: ContactLaw>(law: &L, pairs: &Pairs<L::History>, flows: &mut Flows) {
+    for (history, free) in pairs.dropped() {
+        book_release(law, history, free, flows);
+    }
 }
 
 /// The force of the contact in slot `k` of `s` (separation `r`, overlapping), its run guard

@@ -37,7 +37,7 @@ use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
 pub use self::energy::{Flows, LedgerRow, Reading};
-use self::forces::{contact_breach, pair_chunk, pair_force, PairView};
+use self::forces::{book_dropped, contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
@@ -95,6 +95,11 @@ pub trait Engine: Send {
     /// the energy and momentum flows accumulated over every step run so far, and the state's
     /// energies and free momentum. Two readings give the ledgers of the steps between them.
     fn ledger(&self) -> Reading;
+    /// The ledgers' flows accumulated over every step run so far (those of [`Engine::ledger`]).
+    fn flows(&self) -> Flows;
+    /// Sets the accumulated flows: a run resumed from a checkpoint continues those of the run
+    /// that wrote it.
+    fn set_flows(&mut self, flows: Flows);
     /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
     /// with the reason, when the run guard finds a number that cannot be trusted; after that
     /// every call fails the same way.
@@ -134,7 +139,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         <L::History as History>::WORDS
     }
     fn rebuild(&mut self) {
-        self.core.rebuild()
+        self.rebuild_booked()
     }
     fn contact_count(&self) -> usize {
         self.core.contact_count()
@@ -159,6 +164,12 @@ impl<L: ContactLaw> Engine for Simulation<L> {
             &c.pairs,
             (s.step, c.params.dt, c.flows),
         )
+    }
+    fn flows(&self) -> Flows {
+        self.core.flows
+    }
+    fn set_flows(&mut self, flows: Flows) {
+        self.core.flows = flows;
     }
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
@@ -241,6 +252,13 @@ impl<L: ContactLaw> Simulation<L> {
         }
     }
 
+    /// Rebuilds the pair list on this thread ([`Core::rebuild`]) and books the contacts it
+    /// closed as the pair pass would have ([`forces::book_dropped`]).
+    fn rebuild_booked(&mut self) {
+        self.core.rebuild();
+        book_dropped(&self.law, &self.core.pairs, &mut self.core.flows);
+    }
+
     /// A simulation of `core` under the contact law `law`.
     pub fn new(law: L, core: Core<L::History>) -> Self {
         Simulation { law, core }
@@ -249,7 +267,7 @@ impl<L: ContactLaw> Simulation<L> {
     /// MercuryDPM evaluates the forces once before the first step, at x_0 with v_0. The run
     /// guard checks the positions first.
     fn initial_forces(&mut self) {
-        self.core.rebuild();
+        self.rebuild_booked();
         let state = &self.core.state;
         if let Some(b) = guard::outside(&state.particles, &state.domain) {
             self.core.failure = Some(b.report(state.step, state.time, &state.id));
@@ -606,8 +624,10 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         gap_closed(self.bound).into_iter().fold(0.0, f64::max) > self.team.skin
     }
 
-    /// The team rebuilds the pair list between two barriers; thread 0 then retakes the views and
-    /// checks every position (the run guard; a breach stops the run at the next meeting).
+    /// The team rebuilds the pair list between two barriers; thread 0 then books the contacts
+    /// the rebuild closed (as this step's pair pass would have: [`forces::book_dropped`]),
+    /// retakes the views and checks every position (the run guard; a breach stops the run at
+    /// the next meeting).
     fn rebuild(&mut self, s: u64) {
         let team = self.team;
         self.bound = [0.0; 2];
@@ -625,6 +645,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             if let Some(b) = guard::outside(l.particles, team.kick.domain) {
                 team.alarm.raise(s, b);
             }
+            book_dropped(team.law, l.pairs, &mut self.flows);
             // SAFETY: as above.
             unsafe { *team.arrays.exclusive() = Arrays::of(l) };
             self.times.rebuilds += 1;
