@@ -280,7 +280,12 @@ fn a_run_stopped_by_a_signal_continues_bit_for_bit() {
     };
     assert!(hash(&straight.out).is_some());
     assert_eq!(hash(&resumed.out), hash(&straight.out));
-    for name in ["shear_flow_quick.data.0040", "shear_flow_quick.fstat.0003"] {
+    for name in [
+        "shear_flow_quick.data.0040",
+        "shear_flow_quick.fstat.0003",
+        "shear_flow_quick.profiles_inrun.csv",
+        "shear_flow_quick.profiles_inrun_errors.csv",
+    ] {
         let a = std::fs::read(stopped.path().join(name)).unwrap();
         let b = std::fs::read(straight_dir.path().join(name)).unwrap();
         assert!(a == b, "{name} differs");
