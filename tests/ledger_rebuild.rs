@@ -50,14 +50,10 @@ fn pulled_apart(skin: f64) -> (f64, LedgerRow, LedgerRow, u64) {
     let xi = &snap.contacts[0].history;
     let held = 0.5 * KT * (xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
     let loading = e.ledger().since(&start);
-    let v = &mut e.core.state.particles.v;
-    let (a, b) = if e.core.state.id[0] == 0 {
-        (0, 1)
-    } else {
-        (1, 0)
-    };
-    v[a].x -= 1.0;
-    v[b].x += 1.0;
+    let mut pulled = snap.clone();
+    pulled.particles.v[0].x -= 1.0;
+    pulled.particles.v[1].x += 1.0;
+    e.restore(&pulled);
     let before = e.ledger();
     let rebuilds = e.counters().rebuilds;
     e.advance(1).unwrap();

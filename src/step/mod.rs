@@ -50,7 +50,10 @@ use counters::Laps;
 /// A simulation: the state and the contact law that advances it.
 pub struct Simulation<L: ContactLaw> {
     pub law: L,
-    pub core: Core<L::History>,
+    /// Changed only through [`Engine`]'s methods: a change of velocities or forces must go
+    /// through a rebuild ([`Engine::restore`]), which the run guard's carried energy and the
+    /// particles' quiet flags rely on.
+    pub(crate) core: Core<L::History>,
 }
 
 /// The law-independent face of a simulation, for the run loop and the tools.
