@@ -215,3 +215,37 @@ fn a_checkpoint_of_format_2_resumes_naming_what_it_lacks() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("resumed at step 10"));
 }
+
+/// A resume whose saves would fall elsewhere than those of the run that wrote the checkpoint
+/// (another --save-every) is refused before anything is written: its ledgers were read at a
+/// save this run does not have.
+#[test]
+fn a_resume_at_another_save_interval_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = RunOptions {
+        end_step: 1500,
+        checkpoint_every: 1500,
+        ..options(dir.path(), None)
+    };
+    let mut first = quick_engine();
+    run::run(first.as_mut(), &opts, false).unwrap();
+    let ck = run::checkpoint_path(dir.path(), "q");
+    let mut second = quick_engine();
+    let resumed = checkpoint::read_run(&ck, second.as_mut(), &opts.tag).unwrap();
+    let table = std::fs::read(run::diagnostics_path(dir.path(), "q")).unwrap();
+    let other = RunOptions {
+        save_every: 700,
+        ..opts
+    };
+    let err = run::run_resumed(second.as_mut(), &other, &resumed, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("read at the save of step 1000, but with a save every 700 steps the last save before step 1500 is at step 1400"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(run::diagnostics_path(dir.path(), "q")).unwrap(),
+        table
+    );
+}
