@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use common::*;
+use verdem::analysis::cg::CgOptions;
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::engine::Overrides;
 use verdem::io::checkpoint;
@@ -142,8 +143,8 @@ fn a_resumed_run_writes_the_in_run_profiles_of_a_straight_run() {
     }
 }
 
-/// In-run sums taken at other intervals, or over another window, are refused naming the file
-/// and the field; malformed sums naming the byte.
+/// In-run sums taken at other intervals, up to another step or on other slices are refused
+/// naming the file and the field; truncated sums naming the byte.
 #[test]
 fn in_run_sums_of_another_sampling_are_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -180,6 +181,21 @@ fn in_run_sums_of_another_sampling_are_refused() {
         .to_string();
     assert!(
         err.starts_with("c.ck: in-run sums of the checkpoint truncated at byte"),
+        "{err}"
+    );
+    let coarser = CgOptions {
+        slices: 50,
+        ..CgOptions::for_case(&quick_case())
+    };
+    let mut other_frame = Inrun::new(&coarser, &e.state().domain, taken.sampling()).unwrap();
+    let err = other_frame
+        .restore("c.ck", 40, &bytes, 0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(
+            "c.ck: refused, in-run sums of another coarse-graining: slices 100, this run's 50"
+        ),
         "{err}"
     );
     taken.restore("c.ck", 40, &bytes, 0).unwrap();
