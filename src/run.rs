@@ -321,6 +321,12 @@ fn run_from(
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
     // What a stop leaves: the last save and checkpoint of this run.
     let mut kept = Kept::default();
+    // The ledgers' reading at the last save.
+    let mut last_reading = if opts.write_saves {
+        reading_at_start(engine, start, opts.save_every)?
+    } else {
+        None
+    };
     if opts.write_saves {
         prepare_diagnostics(&diag, engine.state().step, opts.save_every, resumed)
             .map_err(|e| kept.not_written(e, &opts.out_dir))?;
@@ -339,12 +345,6 @@ fn run_from(
     if let Some(o) = observer.as_deref_mut() {
         o.start(engine);
     }
-    // The ledgers' reading at the last save.
-    let mut last_reading = if opts.write_saves {
-        reading_at_start(engine, start, opts.save_every)?
-    } else {
-        None
-    };
     let t0 = Instant::now();
     let mut saves = 0;
     let mut first = true;

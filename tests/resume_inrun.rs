@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use common::*;
+use verdem::analysis::cg::CgOptions;
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::engine::Overrides;
 use verdem::io::checkpoint;
@@ -142,8 +143,8 @@ fn a_resumed_run_writes_the_in_run_profiles_of_a_straight_run() {
     }
 }
 
-/// In-run sums taken at other intervals, or over another window, are refused naming the file
-/// and the field; malformed sums naming the byte.
+/// In-run sums taken at other intervals, up to another step or on other slices are refused
+/// naming the file and the field; truncated sums naming the byte.
 #[test]
 fn in_run_sums_of_another_sampling_are_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -182,6 +183,21 @@ fn in_run_sums_of_another_sampling_are_refused() {
         err.starts_with("c.ck: in-run sums of the checkpoint truncated at byte"),
         "{err}"
     );
+    let coarser = CgOptions {
+        slices: 50,
+        ..CgOptions::for_case(&quick_case())
+    };
+    let mut other_frame = Inrun::new(&coarser, &e.state().domain, taken.sampling()).unwrap();
+    let err = other_frame
+        .restore("c.ck", 40, &bytes, 0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(
+            "c.ck: refused, in-run sums of another coarse-graining: slices 100, this run's 50"
+        ),
+        "{err}"
+    );
     taken.restore("c.ck", 40, &bytes, 0).unwrap();
     assert_eq!(taken.state(), bytes);
 }
@@ -214,4 +230,38 @@ fn a_checkpoint_of_format_2_resumes_naming_what_it_lacks() {
         "{stderr}"
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("resumed at step 10"));
+}
+
+/// A resume whose saves would fall elsewhere than those of the run that wrote the checkpoint
+/// (another --save-every) is refused before anything is written: its ledgers were read at a
+/// save this run does not have.
+#[test]
+fn a_resume_at_another_save_interval_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = RunOptions {
+        end_step: 1500,
+        checkpoint_every: 1500,
+        ..options(dir.path(), None)
+    };
+    let mut first = quick_engine();
+    run::run(first.as_mut(), &opts, false).unwrap();
+    let ck = run::checkpoint_path(dir.path(), "q");
+    let mut second = quick_engine();
+    let resumed = checkpoint::read_run(&ck, second.as_mut(), &opts.tag).unwrap();
+    let table = std::fs::read(run::diagnostics_path(dir.path(), "q")).unwrap();
+    let other = RunOptions {
+        save_every: 700,
+        ..opts
+    };
+    let err = run::run_resumed(second.as_mut(), &other, &resumed, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("read at the save of step 1000, but with a save every 700 steps the last save before step 1500 is at step 1400"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(run::diagnostics_path(dir.path(), "q")).unwrap(),
+        table
+    );
 }
