@@ -522,17 +522,19 @@ impl Inrun {
 
     /// Continues from the sums `bytes` ([`Observer::state`]) that a checkpoint of the same run
     /// at step `step` holds, from byte `at` of `file`: afterwards the accumulator is the one the
-    /// run that wrote the checkpoint had there. Refused, naming the file and the field, when
-    /// they were taken in another frame (slices, kernel, wall spheres, density, area), at other
-    /// intervals or over another window than this run's (this run's window starts at the resume
-    /// when it is past the checkpoint's start), or are malformed.
+    /// run that wrote the checkpoint had there, and the result is `None`. Sums taken in another
+    /// frame (slices, kernel, wall spheres, density, area), at other intervals or over another
+    /// window than this run's (a run resumed with another `--steps` averages another second
+    /// half; this run's window starts at the resume when it is past the checkpoint's start)
+    /// are not taken: the accumulator is left as it was and the result says why. Malformed
+    /// sums are refused, naming the file and the byte.
     pub fn restore(
         &mut self,
         file: &str,
         at: usize,
         bytes: &[u8],
         step: u64,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<Option<String>> {
         let mut r = Reader::new(file, bytes, at, "in-run sums of the checkpoint");
         let what = |w: &'static str| move || format!("in-run sums: {w}");
         let format = r.u64()?;
@@ -561,10 +563,10 @@ impl Inrun {
             } else {
                 differs
             };
-            bail!(
-                "{file}: refused, in-run sums of another coarse-graining: {}",
+            return Ok(Some(format!(
+                "in-run sums of another coarse-graining: {}",
                 differs.join("; ")
-            );
+            )));
         }
         let mut taken = [0u64; 5];
         for v in &mut taken {
@@ -599,11 +601,10 @@ impl Inrun {
             ));
         }
         if !differs.is_empty() {
-            bail!(
-                "{file}: refused, in-run sums taken otherwise than this run takes them: {}; \
-                 resume as the run that wrote it, or with --inrun-every 0",
+            return Ok(Some(format!(
+                "in-run sums taken otherwise than this run takes them: {}",
                 differs.join("; ")
-            );
+            )));
         }
         if bin_steps == 0 || !bin_steps.is_multiple_of(particle_every) {
             bail!(
@@ -677,7 +678,7 @@ impl Inrun {
         self.trace = trace;
         self.free = free;
         self.free_volume = free_volume;
-        Ok(())
+        Ok(None)
     }
 }
 

@@ -279,7 +279,15 @@ fn in_run(
     if let Some((ck, r)) = resumed {
         let file = ck.display().to_string();
         match &r.record.observer {
-            Some(sums) => inrun.restore(&file, r.observer_at, sums, start)?,
+            Some(sums) => {
+                if let Some(why) = inrun.restore(&file, r.observer_at, sums, start)? {
+                    eprintln!(
+                        "warning: {file}: {why}: the in-run profiles average only the steps \
+                         after step {}",
+                        inrun.sampling().from
+                    );
+                }
+            }
             None if inrun.sampling().from == start => eprintln!(
                 "warning: {file}: the checkpoint holds no in-run sums: the in-run profiles cover \
                  only the steps after the resume (step {start})"
