@@ -144,20 +144,23 @@ def contact_force(I):
 
 
 def write_bodies(path, n):
-    """All bodies of step n in id order: radius, wrapped position, full-step velocities."""
+    """All bodies of step n in id order: radius, wrapped position, full-step velocities (one
+    formatted line per body, written at once: the cost of an in-run dump is mostly here)."""
     h = half_step(n)
+    line = " ".join(["%r"] * 10) + "\n"
+    lines = ["# step %d: radius x y z vx vy vz wx wy wz (full-step velocities)\n" % n]
+    forces = O.forces
+    for b in O.bodies:
+        s = b.state
+        v, w = s.vel, s.angVel
+        if b.groupMask == FREE_MASK:
+            v = v + forces.f(b.id) * (h / s.mass)
+            t, i = forces.t(b.id), s.inertia
+            w = Vector3(w[0] + t[0] * h / i[0], w[1] + t[1] * h / i[1], w[2] + t[2] * h / i[2])
+        x = wrapped(s.pos)
+        lines.append(line % (b.shape.radius, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2]))
     with open(path, "w") as f:
-        f.write("# step %d: radius x y z vx vy vz wx wy wz (full-step velocities)\n" % n)
-        for b in O.bodies:
-            s = b.state
-            v, w = s.vel, s.angVel
-            if b.groupMask == FREE_MASK:
-                v = v + O.forces.f(b.id) * (h / s.mass)
-                t = O.forces.t(b.id)
-                w = Vector3(*[w[k] + t[k] * h / s.inertia[k] for k in range(3)])
-            x = wrapped(s.pos)
-            f.write(" ".join(repr(float(q)) for q in [b.shape.radius] + x + list(v) + list(w)))
-            f.write("\n")
+        f.writelines(lines)
 
 
 def write_contacts(n):
