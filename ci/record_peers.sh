@@ -14,9 +14,10 @@
 #   STEPS=N   steps of each run (default 10000000; with --inrun 1000000)
 #   STATE=F   the start state (default: the full run's final state)
 # With --inrun only the in-run comparison is recorded, and no other file of golden/peers is
-# touched: the LAMMPS-family peers named (default lammps and liggghts), 1 rank each, all at once,
-# average in-run (`verdem cross --inrun`: contact stress and wall forces every 8 contact
-# durations, particle fields every 24, from their dumps), as do verdem in each peer's convention
+# touched: the peers named (default lammps, liggghts and yade; those with in-run dumps), 1 rank
+# or thread each, all at once, average in-run (`verdem cross --inrun`: contact stress and wall
+# forces every 8 contact durations, particle fields every 24, from their dumps; Yade, at a few
+# hundred steps/s, takes about an hour for 1e6 steps), as do verdem in each peer's convention
 # and verdem in MercuryDPM's, over the same steps. Kept: each run's in-run profiles
 # (PEER.profiles_inrun.csv, verdem_as_PEER.profiles_inrun.csv, verdem.profiles_inrun.csv) and
 # compare_inrun.md (the core means with 95 % intervals, with provenance).
@@ -39,7 +40,7 @@ BIN="$OUT/verdem"
 cp target/release/verdem "$BIN"
 START_SHA=$(sha256sum "$STATE" | cut -d' ' -f1)
 if [ "$INRUN" = 1 ]; then
-  [ $# -gt 0 ] || set -- lammps liggghts
+  [ $# -gt 0 ] || set -- lammps liggghts yade
   IN="$OUT/inrun"
   for peer in "$@"; do
     "$BIN" cross "$peer" cases/shear_flow.toml --from "$STATE" --steps "$STEPS" --every 50000 \
@@ -64,14 +65,14 @@ if [ "$INRUN" = 1 ]; then
     echo "# The cross-code comparison with in-run averaging in every code (written by ci/record_peers.sh --inrun)"
     echo
     echo "Recorded $(date -u +%Y-%m-%dT%H:%M:%SZ) at commit $COMMIT, from $STATE (SHA-256 $START_SHA),"
-    echo "$STEPS steps of cases/shear_flow.toml, 1 MPI rank or thread per run. Commands:"
+    echo "$STEPS steps of cases/shear_flow.toml, 1 MPI rank or thread per run, all cross-runs at once. Commands:"
     echo
     for peer in "$@"; do
-      echo "- \`verdem cross $peer cases/shear_flow.toml --from $STATE --steps $STEPS --every 50000 --np 1 --inrun\` ($("$BIN" peers "$peer" | cut -f5))"
+      echo "- \`verdem cross $peer cases/shear_flow.toml --from $STATE --steps $STEPS --every 50000 --np 1 --inrun\` ($("$BIN" peers "$peer" | cut -f5); the peer run as \`$("$BIN" peers "$peer" | cut -f4)\`)"
     done
     echo
-    echo "Each runs the peer (\`$("$BIN" peers "$1" | cut -f4)\`, its dumps read by verdem's"
-    echo "in-run accumulator), verdem in the peer's convention and verdem in the case's own (MercuryDPM's)."
+    echo "Each runs the peer, its dumps read by verdem's in-run accumulator, then verdem in the"
+    echo "peer's convention and verdem in the case's own (MercuryDPM's)."
     for peer in "$@"; do
       bin=$("$BIN" peers "$peer" | cut -f2)
       echo

@@ -143,8 +143,8 @@ fn a_peer_without_inrun_dumps_and_intervals_that_do_not_divide_are_refused() {
         .unwrap_err()
         .to_string()
     };
-    let e = run("yade", (200, 200));
-    assert!(e.contains("yade has no in-run dumps"), "{e}");
+    let e = run("kratos", (200, 200));
+    assert!(e.contains("kratos has no in-run dumps"), "{e}");
     let e = run("lammps", (300, 600));
     assert!(e.contains("must be at least 1 and divide"), "{e}");
 }

@@ -1,6 +1,7 @@
 //! Yade (Debian package `yade`, installed by ci/test.sh) runs the scripts verdem generates: the
-//! binary collisions of the verification case against the clipped closed forms, and a short
-//! cross-run from MercuryDPM's developed state against verdem in Yade's convention.
+//! binary collisions of the verification case against the clipped closed forms, a short
+//! cross-run from MercuryDPM's developed state against verdem in Yade's convention, and a short
+//! in-run cross-run (`verdem cross yade --inrun`) read from Yade's in-run dumps.
 
 mod common;
 
@@ -117,4 +118,136 @@ fn a_short_cross_run_agrees_to_round_off_in_yades_convention_only() {
     )
     .unwrap();
     assert!(r.saves[3].dv.max > 1e-7, "{:?}", r.saves[3]);
+}
+
+/// The in-run dumps of Yade (contacts and the positions of the bodies in contact every K steps,
+/// all bodies every KP steps) over 4800 steps of the benchmark from the full run's final state:
+/// every sample is read; Yade and verdem in its convention follow the same trajectory to
+/// round-off over these steps, so their in-run profiles agree to round-off in every column
+/// (which fails if a dump is taken at another instant than the step's forces, or with half-step
+/// velocities); the walls' forces are those of the dumped contacts (the force on each wall
+/// sphere, summed per wall, averaged per bin); verdem in MercuryDPM's convention has a core
+/// pressure of the same sign within 20 % (the conventions differ by clipping and the tangential
+/// cap, a few per cent over 1e6 steps, `golden/peers/compare_inrun.md`); a contact whose body
+/// the position dump lacks is refused, by file.
+#[test]
+fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
+    use verdem::analysis::cg::{self, COLUMNS};
+    use verdem::peers::cross::cross_inrun;
+    use verdem::state::Motion;
+    use verdem::Vec3;
+    let case = Case::load(&common::root().join("cases/shear_flow.toml")).unwrap();
+    let state = common::root().join("golden/full_run/shear_flow.final.data");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("inrun");
+    // contacts every 50 steps, particles every 150: a wall has a contact in about one sample
+    // of 23 at the benchmark's sampling, so each wall has some in 96 samples
+    let (k, kp) = (50, 150);
+    let r = cross_inrun(
+        yade(),
+        &case,
+        yade().convention(),
+        &state,
+        4800,
+        2400,
+        1,
+        &out,
+        Some((k, kp)),
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    for s in &r.saves {
+        assert!(s.dx.max < 1e-9 && s.dv.max < 1e-8, "{s:?}");
+    }
+    let inrun = r.inrun.as_ref().expect("in-run profiles");
+    let (peer, own) = (&inrun.peer, &inrun.verdem_as_peer);
+    assert_eq!((peer.contact_samples, peer.particle_samples), (96, 32));
+    assert_eq!(peer.bin_steps, kp);
+    let (a, b) = (&peer.profiles.mean, &own.profiles.mean);
+    let mut contacts = 0.0;
+    for (c, column) in COLUMNS.iter().enumerate() {
+        let scale = b
+            .iter()
+            .map(|d| cg::columns(d)[c].abs())
+            .fold(0.0, f64::max);
+        for j in 0..a.len() {
+            let (x, y) = (cg::columns(&a[j])[c], cg::columns(&b[j])[c]);
+            assert!(
+                (x - y).abs() <= 1e-6 * scale,
+                "{column} at slice {j}: yade {x}, verdem as yade {y}"
+            );
+        }
+        if column.starts_with("con_") {
+            contacts += scale;
+        }
+    }
+    assert!(contacts > 0.0, "no contact stress");
+    // the walls' forces from the dumped contacts: the force on each wall sphere (group 0
+    // bottom, 1 top), summed per wall, averaged over the samples of each bin
+    let template = common::engine(&case, Some(&state), Default::default()).snapshot();
+    let group = |id: usize| match template.particles.motion[id] {
+        Motion::Prescribed(g) => Some(usize::from(g)),
+        Motion::Free => None,
+    };
+    let yade_dir = out.join("yade");
+    let per_bin = (kp / k) as f64;
+    let mut bins = vec![[Vec3::zeros(); 2]; 32];
+    for step in (k..=4800).step_by(k as usize) {
+        let text = std::fs::read_to_string(yade_dir.join(format!("contacts.{step}.txt"))).unwrap();
+        for line in text.lines().filter(|l| !l.starts_with('#')) {
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .map(|t| t.parse().unwrap())
+                .collect();
+            let on_first = Vec3::new(v[2], v[3], v[4]);
+            let (a, b) = (v[0] as usize, v[1] as usize);
+            let bin = &mut bins[((step - 1) / kp) as usize];
+            match (group(a), group(b)) {
+                (Some(g), None) => bin[g] += on_first / per_bin,
+                (None, Some(g)) => bin[g] -= on_first / per_bin,
+                _ => {}
+            }
+        }
+    }
+    assert_eq!(peer.profiles.wall_force.len(), 32);
+    for (want, got) in bins.iter().zip(&peer.profiles.wall_force) {
+        for g in 0..2 {
+            assert!(
+                (want[g] - got[g]).norm() <= 1e-9 * want[g].norm().max(1.0),
+                "wall {g}: from the dumps {want:?}, in-run {got:?}"
+            );
+        }
+    }
+    assert!(bins.iter().any(|w| w[0].x != 0.0) && bins.iter().any(|w| w[1].x != 0.0));
+    // verdem in MercuryDPM's convention: the core pressure of the same sign and within 20 %
+    let pressure = |res| verdem::peers::inrun::CoreMean::of(res, "pressure").mean;
+    let (p_yade, p_own) = (pressure(peer), pressure(&inrun.verdem));
+    assert!(
+        p_yade > 0.0 && p_own > 0.0 && (p_yade / p_own - 1.0).abs() < 0.2,
+        "core pressure: yade {p_yade}, verdem {p_own}"
+    );
+    // the particle dumps are removed once read, the tables written
+    assert!(!yade_dir.join("particles.150.txt").exists());
+    for csv in ["yade", "verdem", "verdem_own"] {
+        assert!(out.join(format!("{csv}.profiles_inrun.csv")).exists());
+    }
+    assert!(std::fs::read_to_string(out.join("inrun.md"))
+        .unwrap()
+        .contains("| yade | verdem as yade | pressure |"));
+    // a contact whose body is missing from the position dump is refused, by file
+    let positions = yade_dir.join("positions.400.txt");
+    let text = std::fs::read_to_string(&positions).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    assert!(lines.len() > 2, "no body in contact at step 400");
+    lines.remove(1);
+    std::fs::write(&positions, lines.join("\n") + "\n").unwrap();
+    let mut template = template;
+    template.contacts.clear();
+    let e = yade()
+        .read_sample(&yade_dir, 400, &template, false)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("positions.400.txt") && e.contains("missing"),
+        "{e}"
+    );
 }

@@ -38,7 +38,7 @@ pub struct Args {
         value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
     )]
     convention: Option<Tangential>,
-    /// Average in-run too (LAMMPS and LIGGGHTS), in the peer (from dumps every K and KP
+    /// Average in-run too (LAMMPS, LIGGGHTS and Yade), in the peer (from dumps every K and KP
     /// steps), in verdem with the peer's convention and in verdem with the case's own
     /// convention, over the same steps; writes PEER.profiles_inrun.csv,
     /// verdem.profiles_inrun.csv, verdem_own.profiles_inrun.csv and inrun.md, their core means

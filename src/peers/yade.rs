@@ -62,6 +62,8 @@ struct Params<'a> {
     state: &'a str,
     steps: u64,
     every: u64,
+    /// The in-run intervals (contacts and positions, all bodies); (0, 0) for none.
+    inrun: (u64, u64),
     collision: bool,
     wall_vx: Option<(f64, f64)>,
 }
@@ -83,6 +85,8 @@ fn script(p: &Params, what: &str) -> String {
     item("state", format!("{:?}", p.state));
     item("steps", p.steps.to_string());
     item("every", p.every.to_string());
+    item("contact_every", p.inrun.0.to_string());
+    item("particle_every", p.inrun.1.to_string());
     item("collision", flag(p.collision).to_string());
     item("dt", py(p.case.dt()));
     item("kn", py(c.kn));
@@ -149,6 +153,20 @@ fn read_rows(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> 
         rows.push(nums.clone());
     }
     Ok(rows)
+}
+
+/// All bodies of step `step` in a file the script wrote (`save.STEP.txt`,
+/// `particles.STEP.txt`): one line per body in id order, `radius x y z vx vy vz wx wy wz`.
+fn read_bodies(path: &Path, step: u64) -> Result<Frame, FormatError> {
+    let rows = read_rows(path, 10)?;
+    let v3 = |r: &[f64], k: usize| Vec3::new(r[k], r[k + 1], r[k + 2]);
+    Ok(Frame {
+        step,
+        radius: rows.iter().map(|r| r[0]).collect(),
+        x: rows.iter().map(|r| v3(r, 1)).collect(),
+        v: rows.iter().map(|r| v3(r, 4)).collect(),
+        w: rows.iter().map(|r| v3(r, 7)).collect(),
+    })
 }
 
 impl Peer for Yade {
@@ -227,11 +245,111 @@ impl Peer for Yade {
                 state,
                 steps,
                 every: dump_every.unwrap_or(0),
+                inrun: (0, 0),
                 collision: false,
                 wall_vx: Some((vb, vt)),
             },
             &format!("{steps} steps, {output}"),
         ))
+    }
+
+    /// The save runner fires every `contact_every` steps and also writes, besides the saves,
+    /// the contacts (`contacts.STEP.txt`, as a save's) and the positions of the bodies they
+    /// join (`positions.STEP.txt`), and every `particle_every` steps all bodies
+    /// (`particles.STEP.txt`, as `save.STEP.txt`), all at the instant of a save (`run.py`).
+    fn inrun_script(
+        &self,
+        case: &Case,
+        state: &str,
+        steps: u64,
+        every: u64,
+        contact_every: u64,
+        particle_every: u64,
+    ) -> Option<anyhow::Result<String>> {
+        if contact_every == 0
+            || particle_every == 0
+            || !every.is_multiple_of(contact_every)
+            || !particle_every.is_multiple_of(contact_every)
+        {
+            return Some(Err(anyhow::anyhow!(
+                "the save interval ({every}) and the in-run particle interval \
+                 ({particle_every}) must be multiples of the in-run contact interval \
+                 ({contact_every}), all at least 1"
+            )));
+        }
+        Some(wall_speeds(case).map(|(vb, vt)| {
+            script(
+                &Params {
+                    case,
+                    state,
+                    steps,
+                    every,
+                    inrun: (contact_every, particle_every),
+                    collision: false,
+                    wall_vx: Some((vb, vt)),
+                },
+                &format!(
+                    "{steps} steps, a save every {every} steps; in-run dumps: contacts every \
+                     {contact_every} steps, all bodies every {particle_every} steps"
+                ),
+            )
+        }))
+    }
+
+    /// `particles.STEP.txt` for all bodies, `positions.STEP.txt` for the bodies in contact
+    /// and `contacts.STEP.txt` ([`Peer::read_contacts`]); a contact with a body missing from
+    /// `positions.STEP.txt` is an error.
+    fn read_sample(
+        &self,
+        dir: &Path,
+        step: u64,
+        template: &Snapshot,
+        particles: bool,
+    ) -> anyhow::Result<Snapshot> {
+        let mut s = template.clone();
+        s.step = step;
+        s.contacts.clear();
+        let n = s.particles.len();
+        if particles {
+            let path = dir.join(format!("particles.{step}.txt"));
+            let f = read_bodies(&path, step)?;
+            ensure!(
+                f.x.len() == n,
+                "{}: {} bodies, the state has {n}",
+                path.display(),
+                f.x.len()
+            );
+            let p = &mut s.particles;
+            (p.radius, p.x, p.v, p.w) = (f.radius, f.x, f.v, f.w);
+        }
+        let path = dir.join(format!("positions.{step}.txt"));
+        let mut seen = vec![false; n];
+        for r in read_rows(&path, 4)? {
+            let id = r[0] as usize;
+            ensure!(
+                r[0] >= 0.0 && id < n,
+                "{}: body id {} out of range (the state has {n})",
+                path.display(),
+                r[0]
+            );
+            s.particles.x[id] = Vec3::new(r[1], r[2], r[3]);
+            seen[id] = true;
+        }
+        s.contacts = self.read_contacts(dir, step, &s)?;
+        if let Some(c) = s
+            .contacts
+            .iter()
+            .find(|c| !seen[c.p as usize] || !seen[c.i as usize])
+        {
+            bail!(
+                "{}: the contact of bodies {} and {} in contacts.{step}.txt has a body missing \
+                 here",
+                path.display(),
+                c.p,
+                c.i
+            );
+        }
+        Ok(s)
     }
 
     /// The fixed sphere is blocked at rest; the normal force's duration is recorded.
@@ -242,6 +360,7 @@ impl Peer for Yade {
                 state,
                 steps,
                 every: steps,
+                inrun: (0, 0),
                 collision: true,
                 wall_vx: None,
             },
@@ -287,15 +406,7 @@ impl Peer for Yade {
 
     /// `save.STEP.txt` in `dir`: positions wrapped into the box, full-step velocities.
     fn read_frame(&self, dir: &Path, step: u64) -> anyhow::Result<Frame> {
-        let rows = read_rows(&dir.join(format!("save.{step}.txt")), 10)?;
-        let v3 = |r: &[f64], k: usize| Vec3::new(r[k], r[k + 1], r[k + 2]);
-        Ok(Frame {
-            step,
-            radius: rows.iter().map(|r| r[0]).collect(),
-            x: rows.iter().map(|r| v3(r, 1)).collect(),
-            v: rows.iter().map(|r| v3(r, 4)).collect(),
-            w: rows.iter().map(|r| v3(r, 7)).collect(),
-        })
+        Ok(read_bodies(&dir.join(format!("save.{step}.txt")), step)?)
     }
 
     /// `contacts.STEP.txt` in `dir`: the forces the law applied at that step (elastic part

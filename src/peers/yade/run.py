@@ -16,6 +16,11 @@
 # A save of step n (save.n.txt, contacts.n.txt) is taken after the forces of step n and before
 # the kick: positions, contacts and forces of the same instant, velocities converted to full
 # step by adding F(n) dt/2m (and T(n) dt/2I).
+#
+# In-run dumps (contact_every > 0), taken at the same instant by the same runner: every
+# contact_every steps the contacts (contacts.n.txt, as a save's) and the positions of the bodies
+# they join (positions.n.txt), every particle_every steps all bodies (particles.n.txt, as
+# save.n.txt).
 import math
 import time
 
@@ -138,23 +143,29 @@ def contact_force(I):
     return -total, elastic / ph.ks
 
 
-def save():
-    n = O.iter
-    if n % P["every"]:
-        return
+def write_bodies(path, n):
+    """All bodies of step n in id order: radius, wrapped position, full-step velocities (one
+    formatted line per body, written at once: the cost of an in-run dump is mostly here)."""
     h = half_step(n)
-    with open("save.%d.txt" % n, "w") as f:
-        f.write("# step %d: radius x y z vx vy vz wx wy wz (full-step velocities)\n" % n)
-        for b in O.bodies:
-            s = b.state
-            v, w = s.vel, s.angVel
-            if b.groupMask == FREE_MASK:
-                v = v + O.forces.f(b.id) * (h / s.mass)
-                t = O.forces.t(b.id)
-                w = Vector3(*[w[k] + t[k] * h / s.inertia[k] for k in range(3)])
-            x = wrapped(s.pos)
-            f.write(" ".join(repr(float(q)) for q in [b.shape.radius] + x + list(v) + list(w)))
-            f.write("\n")
+    line = " ".join(["%r"] * 10) + "\n"
+    lines = ["# step %d: radius x y z vx vy vz wx wy wz (full-step velocities)\n" % n]
+    forces = O.forces
+    for b in O.bodies:
+        s = b.state
+        v, w = s.vel, s.angVel
+        if b.groupMask == FREE_MASK:
+            v = v + forces.f(b.id) * (h / s.mass)
+            t, i = forces.t(b.id), s.inertia
+            w = Vector3(w[0] + t[0] * h / i[0], w[1] + t[1] * h / i[1], w[2] + t[2] * h / i[2])
+        x = wrapped(s.pos)
+        lines.append(line % (b.shape.radius, x[0], x[1], x[2], v[0], v[1], v[2], w[0], w[1], w[2]))
+    with open(path, "w") as f:
+        f.writelines(lines)
+
+
+def write_contacts(n):
+    """The contacts of step n (contacts.n.txt); returns the ids of the bodies they join."""
+    ids = set()
     with open("contacts.%d.txt" % n, "w") as f:
         f.write("# step %d: id1 id2 (0-based) force on id1, spring of id1 (length)\n" % n)
         for I in O.interactions:
@@ -164,6 +175,33 @@ def save():
             force, spring = contact_force(I)
             f.write("%d %d %s\n" % (I.id1, I.id2, " ".join(
                 repr(float(q)) for q in list(force) + list(spring))))
+            ids.add(I.id1)
+            ids.add(I.id2)
+    return ids
+
+
+def write_positions(n, ids):
+    """The wrapped positions of the bodies `ids` at step n (positions.n.txt), by id."""
+    with open("positions.%d.txt" % n, "w") as f:
+        f.write("# step %d: id (0-based) x y z of every body in contact\n" % n)
+        for i in sorted(ids):
+            x = wrapped(O.bodies[i].state.pos)
+            f.write("%d %s\n" % (i, " ".join(repr(float(q)) for q in x)))
+
+
+def dump():
+    """The saves every `every` steps and the in-run dumps (see the top of this file)."""
+    n = O.iter
+    save = n % P["every"] == 0
+    sample = P["contact_every"] > 0 and n % P["contact_every"] == 0
+    if save:
+        write_bodies("save.%d.txt" % n, n)
+    if save or sample:
+        ids = write_contacts(n)
+    if sample:
+        write_positions(n, ids)
+        if n % P["particle_every"] == 0:
+            write_bodies("particles.%d.txt" % n, n)
 
 
 FORCE_STEPS = []
@@ -188,7 +226,8 @@ engines = [
                     [Law2_ScGeom_ViscElPhys_Basic()]),
 ]
 if P["every"] > 0:
-    engines.append(PyRunner(command="save()", iterPeriod=P["every"], initRun=True))
+    period = P["contact_every"] if P["contact_every"] > 0 else P["every"]
+    engines.append(PyRunner(command="dump()", iterPeriod=period, initRun=True))
 if P["collision"]:
     engines.append(PyRunner(command="watch()", iterPeriod=1, initRun=True))
 engines.append(PyRunner(command="first_half_kick()", iterPeriod=1, initRun=True, label="kick"))
