@@ -75,6 +75,22 @@ fn a_five_sigma_bias_costs_and_a_wide_zero_bias_is_undecided() {
     assert!(matches!(call(&small, false, 0.02), Call::Undecided { .. }));
     // the reference's bits are free whatever the intervals say
     assert_eq!(call(&wide, true, 0.02), Call::Free { same_bits: true });
+    // a control with one interval of five missing 0 passes; with two it fails, and then no
+    // verdict but the reference's bits is settled
+    let mut control = all.clone();
+    control[0] = bias("vx", five_sigma, 0.002, true);
+    assert!(tradeoff::control_passes(&control));
+    control[3] = bias("pressure", -five_sigma, 0.002, true);
+    assert!(!tradeoff::control_passes(&control));
+    let failed = Some(tradeoff::coverage(&control));
+    assert_eq!(failed, Some((3, 5)));
+    assert!(tradeoff::judged(&b, false, 0.02, failed).starts_with("undecided: the control fails"));
+    assert!(tradeoff::judged(&all, false, 0.02, failed).starts_with("undecided"));
+    assert_eq!(
+        tradeoff::judged(&all, true, 0.02, failed),
+        "free (same bits)"
+    );
+    assert!(tradeoff::judged(&b, false, 0.02, Some((4, 5))).starts_with("**costs** pressure"));
 }
 
 #[test]
@@ -176,6 +192,135 @@ fn variants_change_what_they_should_and_nothing_else() {
         table.lines().filter(|l| l.starts_with("| ")).count(),
         1 + 10
     );
+}
+
+/// The resolution the recorded trade is judged at (golden/tradeoff/provenance.toml).
+const RECORDED_RESOLUTION: f64 = 0.02;
+
+/// The recorded trade (golden/tradeoff, see its provenance.toml): its table is what
+/// `verdem tradeoff --table` makes of its CSV, docs/performance.md quotes that table row by row,
+/// and what the docs say of it holds.
+#[test]
+fn the_recorded_trade_says_what_the_docs_say() {
+    let root = common::root();
+    let dir = root.join("golden/tradeoff");
+    let path = dir.join("tradeoff.csv");
+    let out = tradeoff::read_csv(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let case = verdem::case::Case::load(&root.join("cases/shear_flow_steady.toml")).unwrap();
+    let speed = tradeoff::wall_speed(&case);
+    let table = tradeoff::markdown(&out, speed, RECORDED_RESOLUTION);
+    assert_eq!(
+        table,
+        std::fs::read_to_string(dir.join("tradeoff.md")).unwrap()
+    );
+    let docs = std::fs::read_to_string(root.join("docs/performance.md")).unwrap();
+    for row in table.lines().filter(|l| l.starts_with("| ")) {
+        assert!(
+            docs.contains(row),
+            "docs/performance.md lacks the row {row}"
+        );
+    }
+    let by = |name: &str| out.iter().find(|o| o.name == name).unwrap();
+    let reference = by(REFERENCE);
+    let verdict = |name: &str| {
+        let o = by(name);
+        call(
+            &tradeoff::biases(o, reference, speed),
+            o.hash == reference.hash,
+            RECORDED_RESOLUTION,
+        )
+    };
+    let rel = |name: &str, field: &str| {
+        let b = tradeoff::biases(by(name), reference, speed);
+        let b = b.into_iter().find(|b| b.diff.field == field).unwrap();
+        (
+            b.relative(),
+            b.relative_half_width(),
+            b.diff.errors_trusted(),
+        )
+    };
+    // the control fails: 2 of its 5 intervals contain 0; vx and T miss with errors too small,
+    // the pressure with trusted ones
+    let control = tradeoff::biases(by(CONTROL), reference, speed);
+    assert_eq!(tradeoff::coverage(&control), (2, 5));
+    assert!(!tradeoff::control_passes(&control));
+    let missed: Vec<(&str, bool)> = control
+        .iter()
+        .filter(|b| !b.contains_zero())
+        .map(|b| (b.diff.field, b.diff.errors_trusted()))
+        .collect();
+    assert_eq!(missed, [("vx", false), ("T", false), ("pressure", true)]);
+    let coverage = Some(tradeoff::coverage(&control));
+    let physics = ["dt=tc/25", "dt=tc/100", "dt=tc/200", "kn/10", "kn/100"];
+    for name in physics {
+        let o = by(name);
+        let b = tradeoff::biases(o, reference, speed);
+        // so no verdict is settled ...
+        let shown = tradeoff::judged(&b, false, RECORDED_RESOLUTION, coverage);
+        assert!(
+            shown.starts_with("undecided: the control fails"),
+            "{name}: {shown}"
+        );
+        // ... though at face value each costs in pressure (lower) and shear stress (higher),
+        // the signs of the control's own offsets
+        match verdict(name) {
+            Call::Costs(c) => {
+                let fields: Vec<&str> = c.iter().map(|c| c.0).collect();
+                assert_eq!(fields, ["pressure", "shear"], "{name}");
+                assert!(c[0].1 < 0.0 && c[1].1 > 0.0, "{name}: {c:?}");
+            }
+            other => panic!("{name}: {other}"),
+        }
+    }
+    assert!(rel(CONTROL, "pressure").0 < 0.0 && rel(CONTROL, "shear").0 > 0.0);
+    // the finer time steps are no closer to the reference than dt = tc/25 in pressure
+    let p25 = rel("dt=tc/25", "pressure").0.abs();
+    assert!(["dt=tc/100", "dt=tc/200"]
+        .iter()
+        .all(|n| rel(n, "pressure").0.abs() >= p25));
+    // kn/100 stands out: beyond the control's offsets by more than its half-widths
+    let (p, hp, _) = rel("kn/100", "pressure");
+    let (t, ht, _) = rel("kn/100", "shear");
+    assert!(p < rel(CONTROL, "pressure").0 - hp, "{p} ± {hp}");
+    assert!(t > rel(CONTROL, "shear").0 + ht, "{t} ± {ht}");
+    for name in physics {
+        if name != "kn/100" {
+            assert!(
+                rel(name, "pressure").0 > p && rel(name, "shear").0 < t,
+                "{name}"
+            );
+        }
+    }
+    // skin and threads change no bit: free
+    for name in ["skin=0.05", "skin=0.2", "2 threads"] {
+        assert_eq!(verdict(name), Call::Free { same_bits: true }, "{name}");
+    }
+    // cost in CPU time relative to the reference's: a step is cheaper at a finer dt, dearer
+    // with softer contacts; skin 0.05 is cheaper, skin 0.2 dearer; 2 threads take more CPU
+    let cpu = |name: &str| by(name).cpu_per_time() / reference.cpu_per_time();
+    let steps = |name: &str| by(name).steps_per_time() / reference.steps_per_time();
+    for name in ["dt=tc/100", "dt=tc/200"] {
+        assert!(cpu(name) > 1.0 && cpu(name) < steps(name), "{name}");
+    }
+    assert!(cpu("dt=tc/25") < 1.0);
+    for name in ["kn/10", "kn/100"] {
+        assert!(cpu(name) > steps(name) && cpu(name) < 1.0, "{name}");
+    }
+    assert!(cpu("kn/100") > 2.0 * steps("kn/100"));
+    assert!(cpu("skin=0.05") < 0.85 && cpu("skin=0.2") > 1.0);
+    assert!(cpu("2 threads") > 1.5);
+    // the restitution error halves with each halving of dt; softer contacts keep it
+    let e = |name: &str| by(name).restitution_error.abs();
+    for (coarse, fine) in [
+        ("dt=tc/25", REFERENCE),
+        (REFERENCE, "dt=tc/100"),
+        ("dt=tc/100", "dt=tc/200"),
+    ] {
+        assert!((e(coarse) / e(fine) - 2.0).abs() < 0.2, "{coarse} {fine}");
+    }
+    for name in ["kn/10", "kn/100"] {
+        assert!((e(name) - e(REFERENCE)).abs() < 1e-9, "{name}");
+    }
 }
 
 /// The cost of determinism (golden/tradeoff/gather_callgrind.toml): the closure that holds the

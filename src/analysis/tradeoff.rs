@@ -12,7 +12,8 @@
 //!
 //! A **control** row runs the reference's physics again from the same state under another seed
 //! of the replicas' perturbation: its biases are noise, so about 95 % of its intervals must
-//! contain 0 — the check of the intervals themselves.
+//! contain 0 — the check of the intervals themselves: when it fails ([`control_passes`]), no
+//! verdict but the reference's bits is settled ([`judged`]).
 //!
 //! Replica k of every variant starts from the state with every free particle's velocity
 //! perturbed as replica k of `verdem ensemble` ([`perturb`], [`replica_seed`]); the control's
@@ -500,6 +501,35 @@ pub fn coverage(biases: &[Bias]) -> (usize, usize) {
     )
 }
 
+/// Whether a control's intervals pass: at most one of its five excludes 0 (right 95 %
+/// intervals of a same-physics run pass with probability 0.95⁵ + 5·0.05·0.95⁴ = 97.7 %);
+/// generally, at least all but a fifth of them contain 0.
+pub fn control_passes(control: &[Bias]) -> bool {
+    let (inside, of) = coverage(control);
+    5 * (of - inside) <= of
+}
+
+/// The verdict on a variant as the table gives it: [`call`]'s, unless the control fails
+/// ([`control_passes`]; `control_coverage` = its intervals containing 0, of how many): then
+/// the intervals are too narrow to settle anything but the reference's bits, and the verdict is
+/// "undecided", with what [`call`] would say at face value.
+pub fn judged(
+    biases: &[Bias],
+    same_bits: bool,
+    resolution: f64,
+    control: Option<(usize, usize)>,
+) -> String {
+    let c = call(biases, same_bits, resolution);
+    match control {
+        Some((inside, of)) if 5 * (of - inside) > of && c != (Call::Free { same_bits: true }) => {
+            format!(
+                "undecided: the control fails ({inside} of {of} of its intervals contain 0); at face value {c}"
+            )
+        }
+        _ => c.to_string(),
+    }
+}
+
 /// The table as markdown: per variant its cost (steps and CPU seconds per time unit, CPU and
 /// wall time relative to the reference's), restitution error, the bias of each profile with its
 /// 95 % interval (relative), whether it gives the reference's bits, and its verdict at
@@ -512,7 +542,8 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
          blocks, in-run averaging over the second half of each run); † = errors too small \
          (blocks shorter than the field's correlation asks: not settled). Verdict: free = every \
          interval contains 0 and is narrower than ± {}; costs = the profiles whose interval \
-         excludes 0. Cost: CPU time (user + system, all threads of the run) per simulated time \
+         excludes 0; both only when the control passes (at most one of its five intervals excludes \
+         0), else undecided. Cost: CPU time (user + system, all threads of the run) per simulated time \
          unit, relative to the reference's; wall time beside it.\n\n\
          | variant | dt | steps / t.u. | CPU s / t.u. | CPU vs ref | wall vs ref | e error | vx | ν | T | p | τ | same bits | verdict |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -521,6 +552,10 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
     let Some(reference) = outcomes.iter().find(|o| o.name == REFERENCE) else {
         return s;
     };
+    let control = outcomes
+        .iter()
+        .find(|o| o.name == CONTROL)
+        .map(|c| coverage(&biases(c, reference, wall_speed)));
     for o in outcomes {
         let b = biases(o, reference, wall_speed);
         let same = o.hash == reference.hash;
@@ -545,9 +580,14 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
             "—".to_string()
         } else if o.name == CONTROL {
             let (n, of) = coverage(&b);
-            format!("control: {n} of {of} intervals contain 0")
+            let passes = if control_passes(&b) {
+                "passes"
+            } else {
+                "**fails**"
+            };
+            format!("control: {n} of {of} intervals contain 0 ({passes})")
         } else {
-            call(&b, same, resolution).to_string()
+            judged(&b, same, resolution, control)
         };
         s.push_str(&format!(
             "| {} | {:.3e} | {:.0} | {:.3} | {:.2} | {:.2} | {:+.2e} | {} | {} | {} |\n",
