@@ -333,7 +333,10 @@ fn golden_profiles_tables_round_trip_byte_for_byte() {
     for dir in ["golden/peers", "golden/tradeoff"] {
         for entry in std::fs::read_dir(common::root().join(dir)).unwrap() {
             let path = entry.unwrap().path();
-            if path.to_string_lossy().ends_with(".profiles.csv") {
+            let name = path.to_string_lossy().into_owned();
+            if name.ends_with(".profiles.csv")
+                || (dir == "golden/tradeoff" && name.ends_with(".profiles_inrun.csv"))
+            {
                 tables.push(path);
             }
         }

@@ -1,26 +1,42 @@
 //! The speed/accuracy trade (`verdem tradeoff`): the shear case under variants that change cost
 //! (time step, contact stiffness, neighbour skin, threads), each run from the same state for
-//! the same simulated time, with its cost and two accuracy measures:
-//! (a) the relative error of the free–free restitution coefficient at the variant's law and dt
-//!     (head-on, v0 = 1, against the closed form);
-//! (b) the deviation of each z-profile (velocity, concentration, granular temperature, pressure,
-//!     shear stress) from the reference variant's, slice by slice over the core, divided by the
-//!     combined standard error (block averages). Block errors of a short series miss the
-//!     flow's slow fluctuations, so even the same physics gives χ²/dof above 1: the "replica"
-//!     row, the reference's physics over the next stretch of time (started from the
-//!     reference's last save, which holds no tangential springs: the few contacts open at that
-//!     instant restart theirs from zero), measures that noise floor; a variant is within noise
-//!     when its χ²/dof is comparable to the replica's.
+//! the same simulated time with in-run averaging (the accumulator of `verdem run`,
+//! [`Inrun::for_run`]), and for each variant:
+//! - its cost: steps per time unit, and the CPU time (user + system, all its threads) and wall
+//!   time per simulated time unit;
+//! - the relative error of the free–free restitution coefficient at its law and dt (head-on,
+//!   v0 = 1, against the closed form);
+//! - the bias of each profile's core mean (vx, ν, T, pressure, shear stress) against the
+//!   reference's, with its 95 % interval ([`Difference`]: Student's t with Welch's degrees of
+//!   freedom, each core mean's error from the field's own blocks), and a verdict ([`Call`]).
 //!
-//! Softer contacts keep the restitution coefficient (γ scaled with √k, so η/ω is unchanged)
-//! and the resolution tc/dt (dt scaled with 1/√k).
+//! A **control** row runs the reference's physics again from the same state under another seed
+//! of the replicas' perturbation: its biases are noise, so about 95 % of its intervals must
+//! contain 0 — the check of the intervals themselves: when it fails ([`control_passes`]), no
+//! verdict but the reference's bits is settled ([`judged`]).
+//!
+//! Replica k of every variant starts from the state with every free particle's velocity
+//! perturbed as replica k of `verdem ensemble` ([`perturb`], [`replica_seed`]); the control's
+//! replicas take the seeds after the variants'. Every run has one thread, but the threads
+//! variant. Softer contacts keep the restitution coefficient (γ scaled with √k, so η/ω is
+//! unchanged) and the resolution tc/dt (dt scaled with 1/√k).
 
+use std::fmt;
 use std::path::Path;
+use std::time::Instant;
 
-use crate::analysis::cg::{self, CgOptions, Series};
-use crate::case::Case;
+use anyhow::{bail, Context};
+
+use crate::analysis::cg::COLUMNS;
+use crate::analysis::cg::FIELDS;
+use crate::analysis::inrun::{self, Inrun};
+use crate::analysis::stats::standard_error;
+use crate::case::{Case, Scene};
 use crate::engine::{self, Overrides};
-use crate::run::{self, RunOptions};
+use crate::ensemble::{perturb, replica_seed};
+use crate::io::atomic;
+use crate::peers::inrun::{CoreMean, Difference};
+use crate::run::{self, Observer, RunOptions};
 use crate::verify::{closed_form, collide};
 
 /// One variant of the reference case.
@@ -31,10 +47,27 @@ pub struct Variant {
     pub overrides: Overrides,
 }
 
+/// Name of the reference variant.
+pub const REFERENCE: &str = "reference";
+
+/// Name of the row that repeats the reference's physics under another seed.
+pub const CONTROL: &str = "control (reference physics, other seed)";
+
+/// Threads of the threads variant (every other run has one).
+pub const TEAM: usize = 2;
+
+/// Saves a run's in-run window is placed by: as `verdem run` with this many saves, the second
+/// half of the run (the first half lets a variant's flow settle into its own steady state).
+pub const SAVES: u64 = 40;
+
 /// The variants of `base` (the reference first): dt = tc/25, tc/100, tc/200; kn/10 and kn/100;
-/// skins 0.05 and 0.2; 1 thread.
+/// skins 0.05 and 0.2; [`TEAM`] threads. All but the last run on one thread.
 pub fn variants(base: &Case) -> Vec<Variant> {
     let per_tc = base.tc_free_free().unwrap_or(0.0) / base.dt();
+    let one = Overrides {
+        threads: Some(1),
+        ..Overrides::default()
+    };
     let with = |name: &str, f: &dyn Fn(&mut Case), o: Overrides| {
         let mut case = base.clone();
         f(&mut case);
@@ -63,114 +96,235 @@ pub fn variants(base: &Case) -> Vec<Variant> {
     };
     let skin = |s: f64| Overrides {
         skin: Some(s),
-        ..Overrides::default()
+        ..one.clone()
     };
     vec![
-        with("reference", &|_| {}, Overrides::default()),
-        with("dt=tc/25", &resolution(25.0), Overrides::default()),
-        with("dt=tc/100", &resolution(100.0), Overrides::default()),
-        with("dt=tc/200", &resolution(200.0), Overrides::default()),
-        with("kn/10", &softer(10.0), Overrides::default()),
-        with("kn/100", &softer(100.0), Overrides::default()),
+        with(REFERENCE, &|_| {}, one.clone()),
+        with("dt=tc/25", &resolution(25.0), one.clone()),
+        with("dt=tc/100", &resolution(100.0), one.clone()),
+        with("dt=tc/200", &resolution(200.0), one.clone()),
+        with("kn/10", &softer(10.0), one.clone()),
+        with("kn/100", &softer(100.0), one.clone()),
         with("skin=0.05", &|_| {}, skin(0.05)),
         with("skin=0.2", &|_| {}, skin(0.2)),
         with(
-            "1 thread",
+            &format!("{TEAM} threads"),
             &|_| {},
             Overrides {
-                threads: Some(1),
+                threads: Some(TEAM),
                 ..Overrides::default()
             },
         ),
     ]
 }
 
-pub use cg::FIELDS;
+/// How long each variant runs and how its replicas start.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan {
+    /// Simulated time of every run (time units).
+    pub time: f64,
+    /// Replicas of every variant (one thread each, merged per variant).
+    pub replicas: u64,
+    /// Base seed of the replicas' perturbations ([`replica_seed`]).
+    pub base_seed: u64,
+    /// Root-mean-square speed of each replica's velocity perturbation (velocity units).
+    pub perturbation: f64,
+}
 
-/// Name of the row that repeats the reference's physics over the next stretch of time.
-pub const REPLICA: &str = "replica (next stretch)";
-
-/// Cost and accuracy of one variant.
-#[derive(Clone, Debug)]
+/// Cost and accuracy of one variant, over its replicas.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Outcome {
     pub name: String,
     pub dt: f64,
+    /// Steps of each replica.
     pub steps: u64,
-    /// Wall time of the run (including its few saves), seconds.
-    pub seconds: f64,
+    pub replicas: u64,
+    /// CPU time (user + system, all threads of the process while the runs advanced) of all
+    /// replicas, seconds.
+    pub cpu_seconds: f64,
+    /// Wall time of all replicas, seconds.
+    pub wall_seconds: f64,
     /// Relative error of the free–free restitution coefficient.
     pub restitution_error: f64,
-    /// χ²/dof of each profile of [`FIELDS`] against the reference (0 for the reference).
-    pub chi2: [f64; 5],
-    /// Final state hash; equal to the reference's when the variant changes no bit.
+    /// Final state hash of replica 0; equal to the reference's when the variant changes no bit.
     pub hash: String,
+    /// Per profile of [`FIELDS`]: its core mean over the in-run window, merged over the
+    /// replicas ([`merge_core`]).
+    pub core: Vec<CoreMean>,
 }
 
 impl Outcome {
-    /// Simulated time per wall-clock second.
-    pub fn time_per_second(&self) -> f64 {
-        self.steps as f64 * self.dt / self.seconds
+    /// Simulated time of all replicas (time units).
+    pub fn simulated(&self) -> f64 {
+        self.steps as f64 * self.dt * self.replicas as f64
+    }
+
+    /// Steps per simulated time unit (1/dt).
+    pub fn steps_per_time(&self) -> f64 {
+        1.0 / self.dt
+    }
+
+    /// CPU seconds per simulated time unit.
+    pub fn cpu_per_time(&self) -> f64 {
+        self.cpu_seconds / self.simulated()
+    }
+
+    /// Wall seconds per simulated time unit.
+    pub fn wall_per_time(&self) -> f64 {
+        self.wall_seconds / self.simulated()
     }
 }
 
-/// Runs every variant of `base` from `state` for `time` time units with `saves` saves each
-/// (written under `out/VARIANT/`), and the replica of the reference from the reference's last
-/// save, coarse-grains all their saves, and compares them with the reference's; the
-/// restitution is measured on the two spheres of `pair` (a `spheres` case) under each variant's
-/// material and law.
+/// The core means of independent replicas merged. One replica: its own. R ≥ 2: their mean,
+/// with the ensemble's standard error sd/√R (sd over the replicas' means; R − 1 degrees of
+/// freedom: blocks = R), trusted whatever each replica's blocks were — independent replicas
+/// sample the slow fluctuations that one run's blocks are too short for.
+pub fn merge_core(parts: &[CoreMean]) -> CoreMean {
+    match parts {
+        [] => CoreMean {
+            mean: f64::NAN,
+            se: f64::NAN,
+            blocks: 0,
+            long_enough: false,
+        },
+        [one] => *one,
+        _ => {
+            let means: Vec<f64> = parts.iter().map(|c| c.mean).collect();
+            CoreMean {
+                mean: means.iter().sum::<f64>() / means.len() as f64,
+                se: standard_error(&means),
+                blocks: means.len(),
+                long_enough: true,
+            }
+        }
+    }
+}
+
+/// CPU time (user + system, all threads) this process has used so far, seconds
+/// (`getrusage(RUSAGE_SELF)`).
+pub fn process_cpu_seconds() -> anyhow::Result<f64> {
+    // SAFETY: rusage is plain data; getrusage writes one into the zeroed struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        bail!(
+            "getrusage: cannot read this process's CPU time: {}",
+            std::io::Error::last_os_error()
+        );
+    }
+    let s = |t: libc::timeval| t.tv_sec as f64 + 1e-6 * t.tv_usec as f64;
+    Ok(s(u.ru_utime) + s(u.ru_stime))
+}
+
+/// The bumpy-shear walls' speed, half the difference of their prescribed x velocities: the
+/// scale of the vx bias (the core mean of vx is near 0); 1 for other scenes.
+pub fn wall_speed(case: &Case) -> f64 {
+    match case.scene {
+        Scene::BumpyShear {
+            bottom_vx, top_vx, ..
+        } => 0.5 * (top_vx - bottom_vx).abs(),
+        _ => 1.0,
+    }
+}
+
+/// Runs every variant of `base` and the control from `state` as `plan` says (each replica's
+/// in-run profiles and their errors written under `out/VARIANT/replica_K/`), and measures the
+/// restitution on the two spheres of `pair` (a `spheres` case) under each variant's material
+/// and law. `done` is shown each outcome as it is finished. The reference comes first, the
+/// control second.
 pub fn run(
     base: &Case,
     pair: &Case,
     state: &Path,
-    time: f64,
-    saves: u64,
+    plan: &Plan,
     out: &Path,
+    done: &mut dyn FnMut(&Outcome),
 ) -> anyhow::Result<Vec<Outcome>> {
-    let mut runs = Vec::new();
+    if plan.replicas == 0 {
+        bail!("the trade needs at least one replica of every variant");
+    }
     let mut all = variants(base);
-    // the replica runs after the reference, from its last save
-    let replica = Variant {
-        name: REPLICA.into(),
+    let control = Variant {
+        name: CONTROL.into(),
         ..all[0].clone()
     };
-    all.insert(1, replica);
-    let mut replica_start: Option<std::path::PathBuf> = None;
+    all.insert(1, control);
+    let mut outcomes = Vec::new();
     for v in all {
         let dt = v.case.dt();
-        let steps = ((time / dt / saves as f64).round() as u64).max(1) * saves;
-        let start = match &replica_start {
-            Some(path) if v.name == REPLICA => path.as_path(),
-            _ => state,
-        };
-        let mut e = engine::build(
-            &v.case,
-            crate::scene::build(&v.case, Some(start))?,
-            &v.overrides,
-        );
-        let dir = out.join(v.name.replace(['/', ' ', '=', '(', ')'], "_"));
-        let summary = run::run(
-            e.as_mut(),
-            &RunOptions {
-                end_step: steps,
-                save_every: steps / saves,
+        let steps = ((plan.time / dt / SAVES as f64).round() as u64).max(1) * SAVES;
+        let mut parts = Vec::new();
+        let (mut cpu, mut wall) = (0.0, 0.0);
+        let mut hash = String::new();
+        for k in 0..plan.replicas {
+            let seed = if v.name == CONTROL {
+                replica_seed(plan.base_seed, plan.replicas + k)
+            } else {
+                replica_seed(plan.base_seed, k)
+            };
+            let mut start = crate::scene::build(&v.case, Some(state))?;
+            perturb(&mut start.particles, plan.perturbation, seed)?;
+            let mut e = engine::build(&v.case, start, &v.overrides);
+            let dir = out
+                .join(v.name.replace(['/', ' ', '=', '(', ')', ','], "_"))
+                .join(format!("replica_{k}"));
+            let first = e.state().step;
+            let opts = RunOptions {
+                end_step: first + steps,
+                save_every: steps / SAVES,
                 checkpoint_every: 0,
                 out_dir: dir.clone(),
                 name: v.case.name.clone(),
                 tag: v.name.clone(),
                 progress: false,
-                write_saves: true,
+                write_saves: false,
                 vtk: false,
                 stop: None,
-            },
-            false,
-        )?;
-        if replica_start.is_none() {
-            replica_start = Some(dir.join(format!("{}.data.{saves:04}", v.case.name)));
+            };
+            let intervals = inrun::intervals(&v.case, None, None);
+            let mut acc = Inrun::for_run(
+                &v.case,
+                e.as_ref(),
+                &opts,
+                intervals,
+                first.div_ceil(opts.save_every),
+            )?;
+            let (cpu0, wall0) = (process_cpu_seconds()?, Instant::now());
+            let summary = run::run_observed(
+                e.as_mut(),
+                &opts,
+                false,
+                Some(&mut acc as &mut dyn Observer),
+            )?;
+            wall += wall0.elapsed().as_secs_f64();
+            cpu += process_cpu_seconds()? - cpu0;
+            let r = acc.result().with_context(|| {
+                format!(
+                    "{} replica {k}: no in-run sample of both particles and contacts in {steps} \
+                     steps; run longer (--time)",
+                    v.name
+                )
+            })?;
+            atomic::write(
+                &inrun::csv_path(&dir, &v.case.name),
+                inrun::csv(&r).as_bytes(),
+            )?;
+            atomic::write(
+                &inrun::errors_csv_path(&dir, &v.case.name),
+                inrun::errors_csv(&r).as_bytes(),
+            )?;
+            parts.push(
+                FIELDS
+                    .iter()
+                    .map(|&(_, c)| CoreMean::of(&r, COLUMNS[c]))
+                    .collect::<Vec<_>>(),
+            );
+            if k == 0 {
+                hash = summary.hash;
+            }
         }
-        let mut o = CgOptions::for_case(&v.case);
-        o.from = Some(0);
-        o.blocks = (saves as usize / 4).clamp(2, 10);
-        let profiles = cg::coarse_grain(&Series::find(&dir.join(&v.case.name))?, &o)?;
+        let core = (0..FIELDS.len())
+            .map(|f| merge_core(&parts.iter().map(|p| p[f]).collect::<Vec<_>>()))
+            .collect();
         let m = v.case.particle_mass();
         let e_ref = closed_form(&v.case, 0.5 * m).e;
         let per_tc = v.case.tc_free_free().unwrap_or(0.0) / dt;
@@ -178,56 +332,364 @@ pub fn run(
         two.contact = v.case.contact.clone();
         two.material = v.case.material.clone();
         let e = collide(&two, 1.0, false, per_tc)?.e;
-        runs.push((
-            Outcome {
-                name: v.name,
-                dt,
-                steps,
-                seconds: summary.seconds,
-                restitution_error: (e - e_ref) / e_ref,
-                chi2: [0.0; 5],
-                hash: summary.hash,
-            },
-            profiles,
-        ));
+        let o = Outcome {
+            name: v.name,
+            dt,
+            steps,
+            replicas: plan.replicas,
+            cpu_seconds: cpu,
+            wall_seconds: wall,
+            restitution_error: (e - e_ref) / e_ref,
+            hash,
+            core,
+        };
+        done(&o);
+        outcomes.push(o);
     }
-    let reference = runs[0].1.clone();
-    Ok(runs
-        .into_iter()
-        .map(|(mut o, p)| {
-            for (f, (_, col)) in FIELDS.iter().enumerate() {
-                o.chi2[f] = cg::chi2(&p, &reference, *col);
-            }
-            o
-        })
-        .collect())
+    Ok(outcomes)
 }
 
-/// The table as markdown: cost (steps, wall time, simulated time per second relative to the
-/// reference) and accuracy (restitution error, χ²/dof per profile, bitwise identity).
-pub fn markdown(outcomes: &[Outcome]) -> String {
-    let mut s = String::from(
-        "| variant | dt | steps | wall s | sim. time/s vs ref | e error | χ² vx | χ² ν | χ² T | χ² p | χ² τ | same bits as ref |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+/// The bias of one profile's core mean: variant (A) − reference (B), with its 95 % interval,
+/// relative to `scale` (the reference's core mean, or the walls' speed for vx).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bias {
+    pub diff: Difference,
+    pub scale: f64,
+}
+
+impl Bias {
+    /// The bias relative to the scale.
+    pub fn relative(&self) -> f64 {
+        self.diff.delta() / self.scale
+    }
+
+    /// Half the width of the 95 % interval relative to the scale.
+    pub fn relative_half_width(&self) -> f64 {
+        self.diff.half_width() / self.scale
+    }
+
+    /// Whether the 95 % interval contains 0.
+    pub fn contains_zero(&self) -> bool {
+        !self.diff.real()
+    }
+}
+
+/// The biases of `variant` against `reference` in each profile of [`FIELDS`]; vx relative to
+/// `wall_speed`, the others to the reference's core mean.
+pub fn biases(variant: &Outcome, reference: &Outcome, wall_speed: f64) -> Vec<Bias> {
+    FIELDS
+        .iter()
+        .enumerate()
+        .map(|(f, &(field, _))| {
+            let b = reference.core[f];
+            Bias {
+                diff: Difference {
+                    field,
+                    a: variant.core[f],
+                    b,
+                    chi2: f64::NAN,
+                },
+                scale: if field == "vx" {
+                    wall_speed
+                } else {
+                    b.mean.abs()
+                },
+            }
+        })
+        .collect()
+}
+
+/// The verdict on a variant.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Call {
+    /// Every profile's interval contains 0 and is narrower than the resolution, with trusted
+    /// errors; or the variant gives the reference's bits (`same_bits`).
+    Free { same_bits: bool },
+    /// Profiles whose interval excludes 0 with trusted errors: (profile, relative bias,
+    /// relative half-width).
+    Costs(Vec<(&'static str, f64, f64)>),
+    /// No trusted interval excludes 0, but not all are settled: the profiles whose interval is
+    /// wider than ±`resolution` (relative half-widths), and those whose errors are too small.
+    Undecided {
+        resolution: f64,
+        wide: Vec<(&'static str, f64)>,
+        too_small: Vec<&'static str>,
+    },
+}
+
+/// The verdict on a variant with biases `biases`: "free" when it gives the reference's bits
+/// (`same_bits`) or when every interval contains 0, is narrower than ±`resolution` (relative)
+/// and comes from errors that are not too small; it "costs" in each profile whose interval
+/// excludes 0 with trusted errors; else it is undecided.
+pub fn call(biases: &[Bias], same_bits: bool, resolution: f64) -> Call {
+    if same_bits {
+        return Call::Free { same_bits: true };
+    }
+    let costs: Vec<_> = biases
+        .iter()
+        .filter(|b| !b.contains_zero() && b.diff.errors_trusted())
+        .map(|b| (b.diff.field, b.relative(), b.relative_half_width()))
+        .collect();
+    if !costs.is_empty() {
+        return Call::Costs(costs);
+    }
+    let wide: Vec<_> = biases
+        .iter()
+        .filter(|b| b.relative_half_width().is_nan() || b.relative_half_width() > resolution)
+        .map(|b| (b.diff.field, b.relative_half_width()))
+        .collect();
+    let too_small: Vec<_> = biases
+        .iter()
+        .filter(|b| !b.diff.errors_trusted())
+        .map(|b| b.diff.field)
+        .collect();
+    if wide.is_empty() && too_small.is_empty() {
+        Call::Free { same_bits: false }
+    } else {
+        Call::Undecided {
+            resolution,
+            wide,
+            too_small,
+        }
+    }
+}
+
+fn percent(x: f64) -> String {
+    format!("{:.2} %", 100.0 * x)
+}
+
+impl fmt::Display for Call {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Call::Free { same_bits: true } => write!(f, "free (same bits)"),
+            Call::Free { same_bits: false } => write!(f, "free"),
+            Call::Costs(c) => {
+                let list: Vec<String> = c
+                    .iter()
+                    .map(|(field, b, h)| format!("{field} {:+.2} % ± {}", 100.0 * b, percent(*h)))
+                    .collect();
+                write!(f, "**costs** {}", list.join(", "))
+            }
+            Call::Undecided {
+                resolution,
+                wide,
+                too_small,
+            } => {
+                let mut parts: Vec<String> = wide
+                    .iter()
+                    .map(|(field, h)| format!("{field} ± {}", percent(*h)))
+                    .collect();
+                if !too_small.is_empty() {
+                    parts.push(format!("errors too small: {}", too_small.join(", ")));
+                }
+                write!(
+                    f,
+                    "undecided (resolution ± {}): {}",
+                    percent(*resolution),
+                    parts.join("; ")
+                )
+            }
+        }
+    }
+}
+
+/// How many of `biases`' intervals contain 0, and of how many.
+pub fn coverage(biases: &[Bias]) -> (usize, usize) {
+    (
+        biases.iter().filter(|b| b.contains_zero()).count(),
+        biases.len(),
+    )
+}
+
+/// Whether a control's intervals pass: at most one of its five excludes 0 (right 95 %
+/// intervals of a same-physics run pass with probability 0.95⁵ + 5·0.05·0.95⁴ = 97.7 %);
+/// generally, at least all but a fifth of them contain 0.
+pub fn control_passes(control: &[Bias]) -> bool {
+    let (inside, of) = coverage(control);
+    5 * (of - inside) <= of
+}
+
+/// The verdict on a variant as the table gives it: [`call`]'s, unless the control fails
+/// ([`control_passes`]; `control_coverage` = its intervals containing 0, of how many): then
+/// the intervals are too narrow to settle anything but the reference's bits, and the verdict is
+/// "undecided", with what [`call`] would say at face value.
+pub fn judged(
+    biases: &[Bias],
+    same_bits: bool,
+    resolution: f64,
+    control: Option<(usize, usize)>,
+) -> String {
+    let c = call(biases, same_bits, resolution);
+    match control {
+        Some((inside, of)) if 5 * (of - inside) > of && c != (Call::Free { same_bits: true }) => {
+            format!(
+                "undecided: the control fails ({inside} of {of} of its intervals contain 0); at face value {c}"
+            )
+        }
+        _ => c.to_string(),
+    }
+}
+
+/// The table as markdown: per variant its cost (steps and CPU seconds per time unit, CPU and
+/// wall time relative to the reference's), restitution error, the bias of each profile with its
+/// 95 % interval (relative), whether it gives the reference's bits, and its verdict at
+/// `resolution`; then the control's coverage. vx is relative to `wall_speed`.
+pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> String {
+    let mut s = format!(
+        "Bias = core mean (z in [3, 19]) of the variant − the reference's, relative to the \
+         reference's (vx: to the walls' speed {wall_speed}), ± half its 95 % interval \
+         (Student's t, Welch's degrees of freedom; each core mean's error from the field's own \
+         blocks, in-run averaging over the second half of each run); † = errors too small \
+         (blocks shorter than the field's correlation asks: not settled). Verdict: free = every \
+         interval contains 0 and is narrower than ± {}; costs = the profiles whose interval \
+         excludes 0; both only when the control passes (at most one of its five intervals excludes \
+         0), else undecided. Cost: CPU time (user + system, all threads of the run) per simulated time \
+         unit, relative to the reference's; wall time beside it.\n\n\
+         | variant | dt | steps / t.u. | CPU s / t.u. | CPU vs ref | wall vs ref | e error | vx | ν | T | p | τ | same bits | verdict |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        percent(resolution)
     );
-    let reference = outcomes.first().map_or(1.0, Outcome::time_per_second);
-    let ref_hash = outcomes.first().map(|o| o.hash.clone()).unwrap_or_default();
+    let Some(reference) = outcomes.iter().find(|o| o.name == REFERENCE) else {
+        return s;
+    };
+    let control = outcomes
+        .iter()
+        .find(|o| o.name == CONTROL)
+        .map(|c| coverage(&biases(c, reference, wall_speed)));
     for o in outcomes {
+        let b = biases(o, reference, wall_speed);
+        let same = o.hash == reference.hash;
+        let cells: Vec<String> = b
+            .iter()
+            .map(|b| {
+                let mark = if b.diff.errors_trusted() { "" } else { " †" };
+                if o.name == REFERENCE {
+                    "—".to_string()
+                } else if same {
+                    "0 (same bits)".to_string()
+                } else {
+                    format!(
+                        "{:+.2} ± {}{mark}",
+                        100.0 * b.relative(),
+                        percent(b.relative_half_width())
+                    )
+                }
+            })
+            .collect();
+        let verdict = if o.name == REFERENCE {
+            "—".to_string()
+        } else if o.name == CONTROL {
+            let (n, of) = coverage(&b);
+            let passes = if control_passes(&b) {
+                "passes"
+            } else {
+                "**fails**"
+            };
+            format!("control: {n} of {of} intervals contain 0 ({passes})")
+        } else {
+            judged(&b, same, resolution, control)
+        };
         s.push_str(&format!(
-            "| {} | {:.3e} | {} | {:.1} | {:.2} | {:+.3e} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
+            "| {} | {:.3e} | {:.0} | {:.3} | {:.2} | {:.2} | {:+.2e} | {} | {} | {} |\n",
             o.name,
             o.dt,
-            o.steps,
-            o.seconds,
-            o.time_per_second() / reference,
+            o.steps_per_time(),
+            o.cpu_per_time(),
+            o.cpu_per_time() / reference.cpu_per_time(),
+            o.wall_per_time() / reference.wall_per_time(),
             o.restitution_error,
-            o.chi2[0],
-            o.chi2[1],
-            o.chi2[2],
-            o.chi2[3],
-            o.chi2[4],
-            if o.hash == ref_hash { "yes" } else { "no" }
+            cells.join(" | "),
+            if same { "yes" } else { "no" },
+            verdict
         ));
     }
     s
+}
+
+/// The outcomes as CSV, one row per variant: what [`markdown`] needs, each core mean with its
+/// standard error, blocks and whether its errors are trusted.
+pub fn csv(outcomes: &[Outcome]) -> String {
+    let mut s =
+        String::from("variant,dt,steps,replicas,cpu_seconds,wall_seconds,restitution_error,hash");
+    for (field, _) in FIELDS {
+        s.push_str(&format!(
+            ",{field}_mean,{field}_se,{field}_blocks,{field}_trusted"
+        ));
+    }
+    s.push('\n');
+    for o in outcomes {
+        s.push_str(&format!(
+            "{},{:e},{},{},{:e},{:e},{:e},{}",
+            o.name,
+            o.dt,
+            o.steps,
+            o.replicas,
+            o.cpu_seconds,
+            o.wall_seconds,
+            o.restitution_error,
+            o.hash
+        ));
+        for c in &o.core {
+            s.push_str(&format!(
+                ",{:e},{:e},{},{}",
+                c.mean, c.se, c.blocks, c.long_enough
+            ));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Reads what [`csv`] wrote (the variant's name is all before the other fields, commas
+/// included); `path` names the file in errors.
+pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
+    let mut out = Vec::new();
+    let columns = 8 + 4 * FIELDS.len();
+    for (n, line) in text.lines().enumerate().skip(1) {
+        let at = |what: &str| format!("{}: line {}: {what}", path.display(), n + 1);
+        // the variant's name may hold commas: the other fields are the last ones
+        let mut v: Vec<&str> = line.rsplitn(columns, ',').collect();
+        v.reverse();
+        if v.len() != columns {
+            bail!(at(&format!("{} fields, expected {columns}", v.len())));
+        }
+        let num = |k: usize| -> anyhow::Result<f64> {
+            let x: f64 = v[k]
+                .parse()
+                .with_context(|| at(&format!("field {} is not a number: {:?}", k + 1, v[k])))?;
+            if !x.is_finite() {
+                bail!(at(&format!("field {} is not finite", k + 1)));
+            }
+            Ok(x)
+        };
+        let int = |k: usize| -> anyhow::Result<u64> {
+            v[k].parse()
+                .with_context(|| at(&format!("field {} is not a count: {:?}", k + 1, v[k])))
+        };
+        let core = (0..FIELDS.len())
+            .map(|f| {
+                let k = 8 + 4 * f;
+                Ok(CoreMean {
+                    mean: num(k)?,
+                    se: num(k + 1)?,
+                    blocks: int(k + 2)? as usize,
+                    long_enough: v[k + 3]
+                        .parse()
+                        .with_context(|| at(&format!("field {} is not true/false", k + 4)))?,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        out.push(Outcome {
+            name: v[0].to_string(),
+            dt: num(1)?,
+            steps: int(2)?,
+            replicas: int(3)?,
+            cpu_seconds: num(4)?,
+            wall_seconds: num(5)?,
+            restitution_error: num(6)?,
+            hash: v[7].to_string(),
+            core,
+        });
+    }
+    Ok(out)
 }
