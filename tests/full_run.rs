@@ -15,9 +15,9 @@ mod common;
 
 use sha2::{Digest, Sha256};
 use verdem::analysis::cg::{self, table::Table, CgOptions, COLUMNS};
+use verdem::analysis::difference::CoreMean;
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::engine::Overrides;
-use verdem::peers::inrun::CoreMean;
 
 fn golden(name: &str) -> std::path::PathBuf {
     common::root().join("golden/full_run").join(name)

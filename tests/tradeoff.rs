@@ -3,8 +3,8 @@
 
 mod common;
 
+use verdem::analysis::difference::{CoreMean, Difference};
 use verdem::analysis::tradeoff::{self, call, Bias, Call, Outcome, Plan, CONTROL, REFERENCE};
-use verdem::peers::inrun::{CoreMean, Difference};
 
 /// A bias of a variant (mean `delta` above a reference at 1.0) with both core means' standard
 /// error `se` from 20 blocks, relative to 1.0.

@@ -219,7 +219,7 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
     }
     assert!(bins.iter().any(|w| w[0].x != 0.0) && bins.iter().any(|w| w[1].x != 0.0));
     // verdem in MercuryDPM's convention: the core pressure of the same sign and within 20 %
-    let pressure = |res| verdem::peers::inrun::CoreMean::of(res, "pressure").mean;
+    let pressure = |res| verdem::analysis::difference::CoreMean::of(res, "pressure").mean;
     let (p_yade, p_own) = (pressure(peer), pressure(&inrun.verdem));
     assert!(
         p_yade > 0.0 && p_own > 0.0 && (p_yade / p_own - 1.0).abs() < 0.2,

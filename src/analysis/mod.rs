@@ -1,11 +1,13 @@
 //! Judging results: the statistics the reports share ([`stats`]), the one verdict type that
 //! the verification table, the profile checks, the timing goals and the cross-runs report
-//! ([`verdict`]), coarse-graining of saves into profiles with their checks ([`cg`]), and the
+//! ([`verdict`]), coarse-graining of saves into profiles with their checks ([`cg`]), two in-run
+//! results compared by their core means ([`difference`]), and the
 //! speed/accuracy trade of the shear case ([`tradeoff`]), the merge of an ensemble's profiles
 //! ([`ensemble`]), a picture of a save's particles
 //! ([`particles`]).
 
 pub mod cg;
+pub mod difference;
 pub mod ensemble;
 pub mod inrun;
 pub mod ledger;

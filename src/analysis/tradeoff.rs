@@ -29,13 +29,13 @@ use anyhow::{bail, Context};
 
 use crate::analysis::cg::COLUMNS;
 use crate::analysis::cg::FIELDS;
+use crate::analysis::difference::{CoreMean, Difference};
 use crate::analysis::inrun::{self, Inrun};
 use crate::analysis::stats::standard_error;
 use crate::case::{Case, Scene};
 use crate::engine::{self, Overrides};
 use crate::ensemble::{perturb, replica_seed};
 use crate::io::atomic;
-use crate::peers::inrun::{CoreMean, Difference};
 use crate::run::{self, Observer, RunOptions};
 use crate::verify::{closed_form, collide};
 

@@ -22,9 +22,10 @@ use std::path::Path;
 
 use anyhow::{ensure, Context};
 
-use super::inrun::{self as peer_inrun, Difference};
+use super::inrun as peer_inrun;
 use super::Peer;
 use crate::analysis::cg::{self, table::Table};
+use crate::analysis::difference::{differences, Difference};
 use crate::analysis::inrun::{self, InrunResult, Sampling};
 use crate::analysis::stats::quantile;
 use crate::analysis::{Limit, Verdict};
@@ -87,17 +88,17 @@ impl InrunReport {
             (
                 peer.to_string(),
                 own.clone(),
-                peer_inrun::differences(&self.peer, &self.verdem),
+                differences(&self.peer, &self.verdem),
             ),
             (
                 as_peer.clone(),
                 own,
-                peer_inrun::differences(&self.verdem_as_peer, &self.verdem),
+                differences(&self.verdem_as_peer, &self.verdem),
             ),
             (
                 peer.to_string(),
                 as_peer,
-                peer_inrun::differences(&self.peer, &self.verdem_as_peer),
+                differences(&self.peer, &self.verdem_as_peer),
             ),
         ]
     }
