@@ -154,10 +154,10 @@ pub fn differences(a: &InrunResult, b: &InrunResult) -> Vec<Difference> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn diff(a: (f64, f64, usize), b: (f64, f64, usize)) -> Difference {
+impl Difference {
+    /// The difference of two core means of the pressure, each `(mean, se, blocks)` from
+    /// blocks as long as its correlation asks (χ²/dof 1): for the tests of what reads it.
+    pub(crate) fn of_pressure_means(a: (f64, f64, usize), b: (f64, f64, usize)) -> Difference {
         let m = |(mean, se, blocks)| CoreMean {
             mean,
             se,
@@ -171,6 +171,11 @@ mod tests {
             chi2: 1.0,
         }
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
 
     #[test]
     fn t_quantiles_are_those_of_the_tables() {
@@ -185,7 +190,7 @@ mod tests {
         // errors 0.03 and 0.04 from 10 blocks each: combined 0.05 with Welch's
         // 0.05⁴ / ((0.03⁴ + 0.04⁴) / 9) = 16.7 degrees of freedom, t = 2.113 (tables: 2.120 for
         // 16, 2.110 for 17): half-width 0.1057
-        let d = diff((1.0, 0.03, 10), (0.88, 0.04, 10));
+        let d = Difference::of_pressure_means((1.0, 0.03, 10), (0.88, 0.04, 10));
         assert!((d.delta() - 0.12).abs() < 1e-12);
         assert!((d.se() - 0.05).abs() < 1e-15);
         let dof = 0.05f64.powi(4) / ((0.03f64.powi(4) + 0.04f64.powi(4)) / 9.0);
@@ -196,7 +201,7 @@ mod tests {
         assert!((d.half_width() - 0.1057).abs() < 5e-4, "{}", d.half_width());
         assert!(d.real());
         // a difference of 0.1 lies within it: not real
-        let d = diff((1.0, 0.03, 10), (0.9, 0.04, 10));
+        let d = Difference::of_pressure_means((1.0, 0.03, 10), (0.9, 0.04, 10));
         assert!(!d.real(), "0.1 against {}", d.half_width());
     }
 }

@@ -115,7 +115,7 @@ pub struct Inrun {
     impulse: Vec<[Vec3; 2]>,
     impulse_steps: Vec<u64>,
     /// The step the engine was last observed at and the walls' impulse since its first step
-    /// there ([`Engine::wall_impulse`]).
+    /// there ([`crate::step::Flows::wall_impulse`]).
     mark: Option<(u64, [Vec3; 2])>,
     /// The contact stress of the sample under way.
     scratch: Raw,
@@ -299,7 +299,7 @@ impl Inrun {
     /// Books the walls' impulse since the engine was last observed into the bin of its
     /// current step, and marks that step.
     fn book_impulse(&mut self, engine: &dyn Engine) {
-        let now = (engine.state().step, engine.wall_impulse());
+        let now = (engine.state().step, engine.flows().wall_impulse());
         if let Some((before, at_before)) = self.mark {
             if now.0 > before {
                 let b = self.bin_of(now.0);

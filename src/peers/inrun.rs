@@ -137,26 +137,10 @@ pub fn markdown(rows: &[(String, String, Vec<Difference>)]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::difference::CoreMean;
-
-    fn diff(a: (f64, f64, usize), b: (f64, f64, usize)) -> Difference {
-        let m = |(mean, se, blocks)| CoreMean {
-            mean,
-            se,
-            blocks,
-            long_enough: true,
-        };
-        Difference {
-            field: "pressure",
-            a: m(a),
-            b: m(b),
-            chi2: 1.0,
-        }
-    }
 
     #[test]
     fn the_table_marks_real_differences_and_too_small_errors() {
-        let mut d = diff((1.0, 0.01, 10), (0.9, 0.01, 10));
+        let mut d = Difference::of_pressure_means((1.0, 0.01, 10), (0.9, 0.01, 10));
         let md = markdown(&[("lmp".into(), "verdem".into(), vec![d.clone()])]);
         assert!(md.contains("| lmp | verdem | pressure |"), "{md}");
         assert!(md.contains("| +11.11 % |"), "{md}");

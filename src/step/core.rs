@@ -205,7 +205,6 @@ impl<H: History> Core<H> {
         self.pairs.active.iter().filter(|a| **a).count()
     }
 
-    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
     /// The active contacts as samples ([`SampledContact`]), sorted by `(p, i)` as a
     /// snapshot's: a pass over the pair list, without copying every particle.
     pub fn contact_sample(&self) -> Vec<SampledContact> {
@@ -228,6 +227,7 @@ impl<H: History> Core<H> {
         contacts
     }
 
+    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
     pub fn snapshot(&self) -> Snapshot {
         let s = &self.state;
         let n = s.particles.len();

@@ -73,9 +73,6 @@ pub trait Engine: Send {
     /// The active contacts, as [`Snapshot::contacts`] has them, with their particles' positions
     /// and radii: a sample of the contact stress without a snapshot of every particle.
     fn contact_sample(&self) -> Vec<SampledContact>;
-    /// The impulse the free particles gave wall group 0 and 1 over every step run so far
-    /// (momentum units; the ledger's [`Flows::impulse`]).
-    fn wall_impulse(&self) -> [Vec3; 2];
     /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
     /// carry this law's history ([`Engine::history_words`] words each).
     fn restore(&mut self, snap: &Snapshot);
@@ -131,9 +128,6 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn contact_sample(&self) -> Vec<SampledContact> {
         self.core.contact_sample()
-    }
-    fn wall_impulse(&self) -> [Vec3; 2] {
-        self.core.flows.wall_impulse()
     }
     fn restore(&mut self, snap: &Snapshot) {
         self.core.restore(snap)
