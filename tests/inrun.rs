@@ -18,16 +18,8 @@ fn col(name: &str) -> usize {
 
 fn options(dir: &std::path::Path, end_step: u64, save_every: u64, saves: bool) -> RunOptions {
     RunOptions {
-        end_step,
-        save_every,
-        checkpoint_every: 0,
-        out_dir: dir.to_path_buf(),
-        name: "s".into(),
-        tag: "s".into(),
-        progress: false,
         write_saves: saves,
-        vtk: false,
-        stop: None,
+        ..common::run_options(dir, "s", end_step, save_every)
     }
 }
 
@@ -91,21 +83,7 @@ fn sampling_the_saves_steps_gives_the_saves_profiles() {
     let (saves, inrun) = steady_run(20_000, 1000, 10, 1000, 1000);
     assert_eq!(inrun.contact_samples, 11);
     assert_eq!(inrun.particle_samples, 11);
-    let a = &saves.mean;
-    let b = &inrun.profiles.mean;
-    for (c, name) in COLUMNS.iter().enumerate() {
-        let scale = a
-            .iter()
-            .map(|d| cg::columns(d)[c].abs())
-            .fold(0.0, f64::max);
-        for k in 0..a.len() {
-            let (x, y) = (cg::columns(&a[k])[c], cg::columns(&b[k])[c]);
-            assert!(
-                (x - y).abs() <= 1e-9 * scale,
-                "{name} at slice {k}: saves {x}, in-run {y}"
-            );
-        }
-    }
+    common::assert_columns_agree(&saves.mean, &inrun.profiles.mean, 1e-9, ("saves", "in-run"));
     // and the walls' mean force over each bin (the steps of a save's interval) equals the
     // diagnostics' mean over that save's interval: the same impulse, read twice
     assert_eq!(saves.wall_force.len(), inrun.profiles.wall_force.len());

@@ -6,7 +6,7 @@
 
 mod common;
 
-use verdem::analysis::cg::{self, CgOptions, Series, COLUMNS};
+use verdem::analysis::cg::{self, CgOptions, Series};
 use verdem::case::Case;
 use verdem::peers::{self, cross::cross_inrun};
 
@@ -50,24 +50,12 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
         };
         let series = Series::find(&out.join(peer.binary()).join(&case.name)).unwrap();
         let saves = cg::coarse_grain(&series, &o).unwrap();
-        let (a, b) = (&saves.mean, &inrun.peer.profiles.mean);
-        let mut contacts = 0.0;
-        for (c, column) in COLUMNS.iter().enumerate() {
-            let scale = a
-                .iter()
-                .map(|d| cg::columns(d)[c].abs())
-                .fold(0.0, f64::max);
-            for k in 0..a.len() {
-                let (x, y) = (cg::columns(&a[k])[c], cg::columns(&b[k])[c]);
-                assert!(
-                    (x - y).abs() <= 1e-9 * scale,
-                    "{name} {column} at slice {k}: saves {x}, in-run {y}"
-                );
-            }
-            if column.starts_with("con_") {
-                contacts += scale;
-            }
-        }
+        let contacts = common::assert_columns_agree(
+            &saves.mean,
+            &inrun.peer.profiles.mean,
+            1e-9,
+            (&format!("{name} saves"), "in-run"),
+        );
         // the peer's contacts were there to be compared
         assert!(contacts > 0.0, "{name}: no contact stress");
         // the wall forces of each sample are those of the saves' contacts

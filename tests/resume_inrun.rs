@@ -24,16 +24,9 @@ const INTERVALS: (u64, u64) = (50, 200);
 
 fn options(dir: &std::path::Path, stop: Option<Arc<AtomicBool>>) -> RunOptions {
     RunOptions {
-        end_step: END,
-        save_every: SAVE_EVERY,
-        checkpoint_every: 0,
-        out_dir: dir.to_path_buf(),
-        name: "q".into(),
         tag: checkpoint::tag(&quick_case()),
-        progress: false,
-        write_saves: true,
-        vtk: false,
         stop,
+        ..run_options(dir, "q", END, SAVE_EVERY)
     }
 }
 

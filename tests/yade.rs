@@ -132,7 +132,6 @@ fn a_short_cross_run_agrees_to_round_off_in_yades_convention_only() {
 /// the position dump lacks is refused, by file.
 #[test]
 fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
-    use verdem::analysis::cg::{self, COLUMNS};
     use verdem::peers::cross::cross_inrun;
     use verdem::state::Motion;
     use verdem::Vec3;
@@ -162,24 +161,12 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
     let (peer, own) = (&inrun.peer, &inrun.verdem_as_peer);
     assert_eq!((peer.contact_samples, peer.particle_samples), (96, 32));
     assert_eq!(peer.bin_steps, kp);
-    let (a, b) = (&peer.profiles.mean, &own.profiles.mean);
-    let mut contacts = 0.0;
-    for (c, column) in COLUMNS.iter().enumerate() {
-        let scale = b
-            .iter()
-            .map(|d| cg::columns(d)[c].abs())
-            .fold(0.0, f64::max);
-        for j in 0..a.len() {
-            let (x, y) = (cg::columns(&a[j])[c], cg::columns(&b[j])[c]);
-            assert!(
-                (x - y).abs() <= 1e-6 * scale,
-                "{column} at slice {j}: yade {x}, verdem as yade {y}"
-            );
-        }
-        if column.starts_with("con_") {
-            contacts += scale;
-        }
-    }
+    let contacts = common::assert_columns_agree(
+        &own.profiles.mean,
+        &peer.profiles.mean,
+        1e-6,
+        ("verdem as yade", "yade"),
+    );
     assert!(contacts > 0.0, "no contact stress");
     // the walls' forces from the dumped contacts: the force on each wall sphere (group 0
     // bottom, 1 top), summed per wall, averaged over the samples of each bin

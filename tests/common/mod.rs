@@ -107,3 +107,37 @@ pub fn assert_resumed_diagnostics(resumed: &str, straight: &str) {
         }
     }
 }
+
+/// Asserts that every column of the profiles `other` equals that of `reference` at every grid
+/// point to `tol` times the column's largest |value| in `reference`; `names` label the two in
+/// the message. Returns the sum of those largest values over the contact-stress columns, which
+/// is positive when there were contacts to compare.
+pub fn assert_columns_agree(
+    reference: &[verdem::analysis::cg::fields::Derived],
+    other: &[verdem::analysis::cg::fields::Derived],
+    tol: f64,
+    names: (&str, &str),
+) -> f64 {
+    use verdem::analysis::cg::{columns, COLUMNS};
+    assert_eq!(reference.len(), other.len(), "grid points");
+    let mut contacts = 0.0;
+    for (c, column) in COLUMNS.iter().enumerate() {
+        let scale = reference
+            .iter()
+            .map(|d| columns(d)[c].abs())
+            .fold(0.0, f64::max);
+        for (k, (r, o)) in reference.iter().zip(other).enumerate() {
+            let (x, y) = (columns(r)[c], columns(o)[c]);
+            assert!(
+                (x - y).abs() <= tol * scale,
+                "{column} at slice {k}: {} {x}, {} {y}",
+                names.0,
+                names.1
+            );
+        }
+        if column.starts_with("con_") {
+            contacts += scale;
+        }
+    }
+    contacts
+}
