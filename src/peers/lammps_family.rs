@@ -19,7 +19,7 @@ use anyhow::{bail, ensure, Context};
 
 pub mod dump;
 
-use super::{wall_speeds, Frame, Peer};
+use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::atomic;
 use crate::state::Motion;
@@ -387,7 +387,7 @@ impl<D: Dialect> Peer for D {
         let path = dir.join(format!("positions.{step}.txt"));
         let (at, atoms) = dump::read_atoms(&path)?;
         ensure!(at == step, "{}: step {at}, expected {step}", path.display());
-        let mut seen = vec![false; n];
+        let mut placed = Vec::with_capacity(atoms.len());
         for a in atoms {
             ensure!(
                 a.id <= n,
@@ -395,24 +395,15 @@ impl<D: Dialect> Peer for D {
                 path.display(),
                 a.id
             );
-            s.particles.x[a.id - 1] = a.x;
-            seen[a.id - 1] = true;
+            placed.push((a.id - 1, a.x));
         }
-        s.contacts = self.read_contacts(dir, step, &s)?;
-        if let Some(c) = s
-            .contacts
-            .iter()
-            .find(|c| !seen[c.p as usize] || !seen[c.i as usize])
-        {
-            bail!(
-                "{}: the contact of atoms {} and {} in contacts.{step}.txt has an atom missing \
-                 here (compute contact/atom did not count it)",
-                path.display(),
-                c.p + 1,
-                c.i + 1
-            );
-        }
-        Ok(s)
+        let atoms = Naming {
+            a: "an atom",
+            many: "atoms",
+            base: 1,
+            hint: " (compute contact/atom did not count it)",
+        };
+        placed_contacts(self, dir, step, s, (&path, placed), &atoms)
     }
 
     /// The fixed spheres (types 2 and 3) are held still by `fix move`.

@@ -279,6 +279,52 @@ pub fn wall_speeds(case: &Case) -> anyhow::Result<(f64, f64)> {
     }
 }
 
+/// How a peer names its particles in a message: `a` with its article ("an atom"), `many` the
+/// plural, `base` its first id (a particle's index plus `base` is its id), `hint` what a missing
+/// one means (empty, or starting with a space).
+pub(crate) struct Naming {
+    pub a: &'static str,
+    pub many: &'static str,
+    pub base: u32,
+    pub hint: &'static str,
+}
+
+/// The end of a peer's in-run sample at `step` in `dir` ([`Peer::read_sample`]): the particles
+/// in contact moved to the positions `placed` (index, position) that its positions file `path`
+/// gives, then `peer`'s contacts on that state. A contact with a particle `placed` lacks is an
+/// error naming the file and both particles.
+pub(crate) fn placed_contacts<P: Peer + ?Sized>(
+    peer: &P,
+    dir: &Path,
+    step: u64,
+    mut s: Snapshot,
+    (path, placed): (&Path, Vec<(usize, Vec3)>),
+    name: &Naming,
+) -> anyhow::Result<Snapshot> {
+    let mut seen = vec![false; s.particles.len()];
+    for (a, x) in placed {
+        s.particles.x[a] = x;
+        seen[a] = true;
+    }
+    s.contacts = peer.read_contacts(dir, step, &s)?;
+    if let Some(c) = s
+        .contacts
+        .iter()
+        .find(|c| !seen[c.p as usize] || !seen[c.i as usize])
+    {
+        bail!(
+            "{}: the contact of {} {} and {} in contacts.{step}.txt has {} missing here{}",
+            path.display(),
+            name.many,
+            c.p + name.base,
+            c.i + name.base,
+            name.a,
+            name.hint
+        );
+    }
+    Ok(s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -29,7 +29,7 @@ use std::process::Command;
 
 use anyhow::{bail, ensure, Context};
 
-use super::{wall_speeds, Frame, Peer};
+use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
@@ -323,7 +323,7 @@ impl Peer for Yade {
             (p.radius, p.x, p.v, p.w) = (f.radius, f.x, f.v, f.w);
         }
         let path = dir.join(format!("positions.{step}.txt"));
-        let mut seen = vec![false; n];
+        let mut placed = Vec::new();
         for r in read_rows(&path, 4)? {
             let id = r[0] as usize;
             ensure!(
@@ -332,24 +332,15 @@ impl Peer for Yade {
                 path.display(),
                 r[0]
             );
-            s.particles.x[id] = Vec3::new(r[1], r[2], r[3]);
-            seen[id] = true;
+            placed.push((id, Vec3::new(r[1], r[2], r[3])));
         }
-        s.contacts = self.read_contacts(dir, step, &s)?;
-        if let Some(c) = s
-            .contacts
-            .iter()
-            .find(|c| !seen[c.p as usize] || !seen[c.i as usize])
-        {
-            bail!(
-                "{}: the contact of bodies {} and {} in contacts.{step}.txt has a body missing \
-                 here",
-                path.display(),
-                c.p,
-                c.i
-            );
-        }
-        Ok(s)
+        let bodies = Naming {
+            a: "a body",
+            many: "bodies",
+            base: 0,
+            hint: "",
+        };
+        placed_contacts(self, dir, step, s, (&path, placed), &bodies)
     }
 
     /// The fixed sphere is blocked at rest; the normal force's duration is recorded.
