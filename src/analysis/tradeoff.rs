@@ -321,6 +321,9 @@ pub fn run(
             if k == 0 {
                 hash = summary.hash;
             }
+            if same_bits(&v.name, &hash, &outcomes) {
+                break;
+            }
         }
         let core = (0..FIELDS.len())
             .map(|f| merge_core(&parts.iter().map(|p| p[f]).collect::<Vec<_>>()))
@@ -336,7 +339,7 @@ pub fn run(
             name: v.name,
             dt,
             steps,
-            replicas: plan.replicas,
+            replicas: parts.len() as u64,
             cpu_seconds: cpu,
             wall_seconds: wall,
             restitution_error: (e - e_ref) / e_ref,
@@ -347,6 +350,16 @@ pub fn run(
         outcomes.push(o);
     }
     Ok(outcomes)
+}
+
+/// Whether a variant's first replica gave the reference's bits (`hash` equal to the reference
+/// row's, the first of `done`). Its further replicas would then repeat the reference's, so the
+/// trade runs one replica of it; the reference and the control run every replica.
+fn same_bits(name: &str, hash: &str, done: &[Outcome]) -> bool {
+    name != CONTROL
+        && done
+            .first()
+            .is_some_and(|r| r.name == REFERENCE && r.hash == hash)
 }
 
 /// The bias of one profile's core mean: variant (A) − reference (B), with its 95 % interval,
