@@ -15,7 +15,7 @@ use crate::case::Case;
 use crate::engine::{self, Overrides};
 use crate::peers::Peer;
 use crate::step::StageTimes;
-use crate::team::{Bound, SpinBarrier};
+use crate::team::{round_trip_ns, Bound, SpinBarrier};
 
 /// One configuration: a code and its number of threads or MPI ranks.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,6 +69,14 @@ impl Config {
     }
 }
 
+/// Hand-overs of the core-to-core probe before and after each run on two or more CPUs: ~2–7 ms
+/// at 80–350 ns a round trip.
+const PROBE_TRIPS: u64 = 20_000;
+
+/// A round whose probe took more than this many times the fastest probe of the bench ran with
+/// its CPUs placed far apart.
+const FAR: f64 = 2.0;
+
 /// Measured rates of one configuration over the rounds, and verdem's stage times.
 #[derive(Clone, Debug)]
 pub struct Measured {
@@ -78,6 +86,9 @@ pub struct Measured {
     /// on CPU k); empty otherwise.
     pub copy_rates: Vec<Vec<f64>>,
     pub stages: Option<StageTimes>,
+    /// For a configuration on two or more CPUs, the core-to-core round trip
+    /// ([`round_trip_ns`], nanoseconds) just before and just after each round's run.
+    pub round_trips: Vec<[f64; 2]>,
 }
 
 impl Measured {
@@ -113,6 +124,7 @@ fn unmeasured(configs: &[Config]) -> Vec<Measured> {
             rates: Vec::new(),
             copy_rates: Vec::new(),
             stages: None,
+            round_trips: Vec::new(),
         })
         .collect()
 }
@@ -210,6 +222,8 @@ fn round(
                     })
                     .collect::<anyhow::Result<Vec<_>>>()?;
                 let copies = *copies;
+                let probed = threads * copies > 1;
+                let before = probed.then(|| round_trip_ns(PROBE_TRIPS)).flatten();
                 let start = std::sync::Barrier::new(copies);
                 let time_copy = |k: usize, e: &mut dyn crate::step::Engine| {
                     let _bound = (copies > 1).then(|| Bound::to_nth_cpu(k, copies)).flatten();
@@ -235,6 +249,11 @@ fn round(
                     own.into_iter().collect::<Result<Vec<f64>, _>>()
                 })?;
                 m.rates.push(own.iter().sum());
+                if let (Some(b), Some(a)) =
+                    (before, probed.then(|| round_trip_ns(PROBE_TRIPS)).flatten())
+                {
+                    m.round_trips.push([b, a]);
+                }
                 if copies > 1 {
                     m.copy_rates.push(own);
                 }
@@ -424,6 +443,9 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             ));
         }
     }
+    if let Some(line) = find(2, 1, false).and_then(|two| placement(m, two)) {
+        s.push_str(&line);
+    }
     for x in m {
         if let (
             Config::Verdem {
@@ -445,6 +467,65 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
         }
     }
     s
+}
+
+/// What the core-to-core probes say of the rounds of `team` (verdem's 2 threads): the median
+/// round trip, and which rounds ran with the two CPUs far apart (a probe before or after the
+/// run over [`FAR`] times the fastest probe of any configuration of `m`) with the team's median
+/// rate in those rounds and in the others. `None` without probes.
+fn placement(m: &[Measured], team: &Measured) -> Option<String> {
+    let fastest = m
+        .iter()
+        .flat_map(|x| x.round_trips.iter().flatten())
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let probes: Vec<f64> = team.round_trips.iter().flatten().copied().collect();
+    if probes.is_empty() || team.round_trips.len() != team.rates.len() {
+        return None;
+    }
+    let far: Vec<bool> = team
+        .round_trips
+        .iter()
+        .map(|p| p[0].max(p[1]) > FAR * fastest)
+        .collect();
+    let rates = |placed_far: bool| -> Vec<f64> {
+        team.rates
+            .iter()
+            .zip(&far)
+            .filter(|(_, &f)| f == placed_far)
+            .map(|(r, _)| *r)
+            .collect()
+    };
+    let (lo, hi) = (
+        probes.iter().copied().fold(f64::INFINITY, f64::min),
+        probes.iter().copied().fold(0.0, f64::max),
+    );
+    let n_far = far.iter().filter(|&&f| f).count();
+    let mut line = format!(
+        "\ncore-to-core round trip around verdem's 2-thread rounds: median {:.0} ns ({lo:.0}–{hi:.0} ns; fastest probe of this bench {fastest:.0} ns); ",
+        median(&probes)
+    );
+    if n_far == 0 {
+        line.push_str("no round ran with the two CPUs placed far apart\n");
+    } else {
+        let (near, far) = (rates(false), rates(true));
+        line.push_str(&format!(
+            "{n_far} of {} rounds ran with the two CPUs placed far apart (a probe over {FAR}× the fastest): verdem 2 threads {} steps/s in those against {} in the others; the ratios above include them\n",
+            team.rates.len(),
+            rate_or_none(&far),
+            rate_or_none(&near)
+        ));
+    }
+    Some(line)
+}
+
+/// The median of `rates` as steps/s, or "none".
+fn rate_or_none(rates: &[f64]) -> String {
+    if rates.is_empty() {
+        String::from("none")
+    } else {
+        format!("{:.0}", median(rates))
+    }
 }
 
 /// One system size of a sweep: a (tiled) case, its state, and the steps each run takes there.
@@ -894,7 +975,42 @@ mod tests {
             rates: rates.to_vec(),
             copy_rates: Vec::new(),
             stages: None,
+            round_trips: Vec::new(),
         }
+    }
+
+    #[test]
+    fn rounds_whose_probe_is_far_above_the_fastest_are_named_with_their_own_rate() {
+        let one = measured(1, 1, &[100.0, 100.0, 100.0]);
+        let mut two = measured(2, 1, &[130.0, 80.0, 120.0]);
+        // the second round's probe after the run is 5× the fastest (60 ns): far
+        two.round_trips = vec![[60.0, 70.0], [65.0, 300.0], [90.0, 110.0]];
+        let line = placement(&[one.clone(), two.clone()], &two).unwrap();
+        assert!(
+            line.contains("median 80 ns (60–300 ns; fastest probe of this bench 60 ns)"),
+            "{line}"
+        );
+        assert!(
+            line.contains("1 of 3 rounds ran with the two CPUs placed far apart"),
+            "{line}"
+        );
+        assert!(
+            line.contains("verdem 2 threads 80 steps/s in those against 125 in the others"),
+            "{line}"
+        );
+        assert!(markdown(&[one.clone(), two.clone()], 1).contains(&line));
+        // a faster probe elsewhere in the bench sets the scale: now two rounds are far
+        let mut pair = measured(1, 2, &[200.0, 200.0, 200.0]);
+        pair.round_trips = vec![[40.0, 40.0]; 3];
+        let line = placement(&[one.clone(), two.clone(), pair], &two).unwrap();
+        assert!(line.contains("2 of 3 rounds"), "{line}");
+        // all near, or no probes
+        two.round_trips = vec![[60.0, 70.0]; 3];
+        assert!(placement(&[two.clone()], &two)
+            .unwrap()
+            .contains("no round ran with the two CPUs placed far apart"));
+        two.round_trips.clear();
+        assert_eq!(placement(&[two.clone()], &two), None);
     }
 
     #[test]
@@ -958,6 +1074,7 @@ mod tests {
             rates: rates.to_vec(),
             copy_rates: Vec::new(),
             stages: None,
+            round_trips: Vec::new(),
         };
         let m = [
             measured(2, 1, &[60.0, 55.0, 70.0, 50.0, 65.0, 58.0]),
@@ -1045,6 +1162,7 @@ mod tests {
             rates: rates.to_vec(),
             copy_rates: Vec::new(),
             stages: None,
+            round_trips: Vec::new(),
         }
     }
 
