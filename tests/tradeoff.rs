@@ -118,6 +118,38 @@ fn replicas_merge_into_their_mean_with_the_ensembles_error() {
 }
 
 #[test]
+fn each_replica_has_its_own_row_of_core_means() {
+    let c = |mean| CoreMean {
+        mean,
+        se: 0.5,
+        blocks: 7,
+        long_enough: true,
+    };
+    let path = common::root().join("golden/tradeoff/tradeoff.csv");
+    let mut out = tradeoff::read_csv(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    out.truncate(2);
+    let fields = out[0].core.len();
+    out[0].replica_core = vec![vec![c(1.0); fields], vec![c(2.0); fields]];
+    out[1].replica_core = vec![vec![c(3.0); fields]];
+    let text = tradeoff::replicas_csv(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "{text}");
+    assert!(lines[0].starts_with("variant,replica,vx_mean,vx_se,vx_blocks,vx_trusted,nu_mean"));
+    assert!(
+        lines[1].starts_with("reference,0,1e0,5e-1,7,true,1e0"),
+        "{}",
+        lines[1]
+    );
+    assert!(lines[2].starts_with("reference,1,2e0,"), "{}", lines[2]);
+    assert!(
+        lines[3].starts_with(&format!("{},0,3e0,", out[1].name)),
+        "{}",
+        lines[3]
+    );
+    assert_eq!(lines[1].split(',').count(), 2 + 4 * fields);
+}
+
+#[test]
 fn variants_change_what_they_should_and_nothing_else() {
     let case = common::quick_case();
     let pair = verdem::case::Case::load(&common::root().join("cases/verify/binary_collision.toml"))

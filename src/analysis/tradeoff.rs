@@ -151,6 +151,9 @@ pub struct Outcome {
     /// Per profile of [`FIELDS`]: its core mean over the in-run window, merged over the
     /// replicas ([`merge_core`]).
     pub core: Vec<CoreMean>,
+    /// Each replica's own core means (per profile of [`FIELDS`]), what `core` merges; empty
+    /// when read back from [`csv`].
+    pub replica_core: Vec<Vec<CoreMean>>,
 }
 
 impl Outcome {
@@ -345,6 +348,7 @@ pub fn run(
             restitution_error: (e - e_ref) / e_ref,
             hash,
             core,
+            replica_core: parts,
         };
         done(&o);
         outcomes.push(o);
@@ -653,6 +657,33 @@ pub fn csv(outcomes: &[Outcome]) -> String {
     s
 }
 
+/// Each replica's core means as CSV, one row per replica run (a variant that gave the
+/// reference's bits has only its first): the variant, the replica, then per profile of
+/// [`FIELDS`] its core mean, standard error, blocks and whether its errors are trusted — what
+/// [`merge_core`] merged into [`csv`]'s row.
+pub fn replicas_csv(outcomes: &[Outcome]) -> String {
+    let mut s = String::from("variant,replica");
+    for (field, _) in FIELDS {
+        s.push_str(&format!(
+            ",{field}_mean,{field}_se,{field}_blocks,{field}_trusted"
+        ));
+    }
+    s.push('\n');
+    for o in outcomes {
+        for (k, part) in o.replica_core.iter().enumerate() {
+            s.push_str(&format!("{},{k}", o.name));
+            for c in part {
+                s.push_str(&format!(
+                    ",{:e},{:e},{},{}",
+                    c.mean, c.se, c.blocks, c.long_enough
+                ));
+            }
+            s.push('\n');
+        }
+    }
+    s
+}
+
 /// Reads what [`csv`] wrote (the variant's name is all before the other fields, commas
 /// included); `path` names the file in errors.
 pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
@@ -702,7 +733,40 @@ pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
             restitution_error: num(6)?,
             hash: v[7].to_string(),
             core,
+            replica_core: Vec::new(),
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(name: &str, hash: &str) -> Outcome {
+        Outcome {
+            name: name.into(),
+            dt: 1.0,
+            steps: 1,
+            replicas: 1,
+            cpu_seconds: 0.0,
+            wall_seconds: 0.0,
+            restitution_error: 0.0,
+            hash: hash.into(),
+            core: Vec::new(),
+            replica_core: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn only_a_variant_with_the_references_bits_stops_after_one_replica() {
+        let done = [outcome(REFERENCE, "abc")];
+        assert!(same_bits("skin=0.05", "abc", &done));
+        assert!(!same_bits("kn/10", "abd", &done));
+        // the control repeats the reference's physics on purpose, under other seeds
+        assert!(!same_bits(CONTROL, "abc", &done));
+        // the reference itself (nothing done yet) and a first row that is not the reference
+        assert!(!same_bits(REFERENCE, "abc", &[]));
+        assert!(!same_bits("skin=0.05", "abc", &[outcome("kn/10", "abc")]));
+    }
 }

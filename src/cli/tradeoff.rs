@@ -96,6 +96,10 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         &a.out.join("tradeoff.csv"),
         tradeoff::csv(&outcomes).as_bytes(),
     )?;
+    atomic::write(
+        &a.out.join("replicas.csv"),
+        tradeoff::replicas_csv(&outcomes).as_bytes(),
+    )?;
     print!("{table}");
     Ok(Finished::Done)
 }
