@@ -84,7 +84,9 @@ fn a_short_run_from_the_final_state_matches_the_steady_profiles_and_the_peers() 
     )
     .unwrap();
     verdem::run::run_observed(e.as_mut(), &opts, false, Some(&mut averaged)).unwrap();
-    contact_stress_matches_the_official_full_run(&averaged.result().unwrap());
+    let inrun = averaged.result().unwrap();
+    contact_stress_matches_the_official_full_run(&inrun);
+    temperature_matches_the_official_full_run(&inrun, dir.path());
     let mut o = CgOptions::for_case(&case);
     o.from = Some(1);
     let series = cg::Series::find(&dir.path().join("s")).unwrap();
@@ -194,6 +196,36 @@ fn contact_stress_matches_the_official_full_run(short: &inrun::InrunResult) {
             z(1.1 * reference)
         );
     }
+}
+
+/// The short run's in-run temperature profile against the second full run's in-run one, judged
+/// with plain statistics: χ²/dof over the core slices below 1.60, the 99.9 % quantile of χ² with
+/// 72 degrees of freedom (both sides' errors; the full run's are ~10 times smaller). T is the
+/// profile whose in-run errors hold in a run this short; vx and ν carry the bed's slow drift,
+/// which the start (the first full run's final state) keeps and no error of one run includes
+/// (docs/statistics.md).
+fn temperature_matches_the_official_full_run(short: &inrun::InrunResult, dir: &std::path::Path) {
+    const QUANTILE: f64 = 1.60;
+    let path = dir.join("inrun.csv");
+    std::fs::write(&path, inrun::csv(short)).unwrap();
+    let ours = Table::read(&path).unwrap();
+    let steady =
+        Table::read(&common::root().join("golden/full_run_official/shear_flow.profiles_inrun.csv"))
+            .unwrap();
+    let window = cg::core_window(&short.profiles.grid);
+    let col = COLUMNS.iter().position(|x| *x == "T").unwrap();
+    let c = cg::table::chi2(&ours, &steady, col, window).unwrap();
+    assert!(
+        c < QUANTILE,
+        "T: chi2/dof {c:.2} against the official full run's in-run profile"
+    );
+    // The yardstick can fail: the full run's temperature 5 % higher.
+    let mut hotter = steady.clone();
+    for row in &mut hotter.mean {
+        row[col] *= 1.05;
+    }
+    let c = cg::table::chi2(&ours, &hotter, col, window).unwrap();
+    assert!(c > QUANTILE, "a 5 % change of T gives only chi2/dof {c:.2}");
 }
 
 /// The long runs of golden/peers all start from the full run's final state and run the same
