@@ -14,6 +14,7 @@ impl Dialect for Liggghts {
     const BINARY: &'static str = "liggghts";
     const CONVENTION: Tangential = Tangential::Liggghts;
     const CONTACT_COLUMNS: usize = 5;
+    const WALLS_FORMAT: Option<&'static str> = None;
 
     /// Each coefficient is a `property/global` for all 3×3 pairs of atom types;
     /// `contact_distance_factor 1.01` resets a tangential spring when its contact ends.
