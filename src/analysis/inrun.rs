@@ -2,8 +2,9 @@
 //! definitions, [`Raw::add_particle`] and [`Raw::add_contact`]) accumulated while a run
 //! advances, from the engine's own contacts and forces rather than from saves: the contact
 //! stress of the contacts alive every `every` steps, the mean force each wall receives over
-//! every step (its impulse from the engine's ledger over the time; from a peer's dumps, which
-//! carry no impulse, the force at the sampled steps), and the particle fields every
+//! every step (its impulse from the engine's ledger over the time; from a peer, the means over
+//! every K steps it writes, [`Inrun::book_wall_mean`], else the force at the sampled steps),
+//! and the particle fields every
 //! `particle_every` steps. Samples go into bins of
 //! consecutive steps (at most [`MAX_BINS`]; two neighbours merge when more would be needed), and
 //! the bins are the series the profiles' standard errors are taken from, with blocks as long as
@@ -111,7 +112,7 @@ pub struct Inrun {
     wall: Vec<[Vec3; 2]>,
     /// Per bin: the impulse the free particles gave the bottom [0] and top [1] wall spheres
     /// over the steps it covers, divided by the time step (force × steps), and those steps;
-    /// zero steps when the samples come without an engine (a peer's dumps).
+    /// zero steps when the samples come without an engine or a peer's means.
     impulse: Vec<[Vec3; 2]>,
     impulse_steps: Vec<u64>,
     /// The step the engine was last observed at and the walls' impulse since its first step

@@ -213,8 +213,8 @@ pub fn markdown(rows: &[(String, String, Vec<Difference>)]) -> String {
          (in-run averaging, docs/statistics.md); Δ = A − B with its 95 % interval (Student's t, \
          Welch's degrees of freedom); real = the interval excludes 0; χ²/dof of the profiles \
          over the core slices (1 = noise); the walls' mean x-force per area (on the wall \
-         from the free spheres: verdem's the mean over every step, from its impulse; a peer's \
-         at the contact samples). \"errors too small\": a field whose blocks are shorter than \
+         from the free spheres, the mean over every step: verdem's from its impulse, a peer's \
+         from its walls.txt). \"errors too small\": a field whose blocks are shorter than \
          its correlation asks, whose interval is then too narrow.\n\n\
          | A | B | profile | A core mean | B core mean | Δ (95 % interval) | Δ / B | χ²/dof | real? |\n\
          |---|---|---|---|---|---|---|---|---|\n",
