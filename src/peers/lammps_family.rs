@@ -42,8 +42,8 @@ pub trait Dialect: Sync {
     /// `read_data data`, the groups ([`GROUPS`]) and the contact law of `case`.
     fn setup_and_law(case: &Case, data: &str) -> String;
 
-    /// The `fix ave/time` keyword value that prints its numbers with 17 significant digits;
-    /// `None` when the code has no such keyword.
+    /// The value of `fix ave/time`'s `format` keyword that prints each number with 17
+    /// significant digits after a space; `None` when the code has no such keyword.
     const WALLS_FORMAT: Option<&'static str>;
 
     /// The `dump_modify` keywords that print every float of a [`DUMP_COLUMNS`] line with 17
