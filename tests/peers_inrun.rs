@@ -7,6 +7,7 @@
 mod common;
 
 use verdem::analysis::cg::{self, CgOptions, Series};
+use verdem::analysis::inrun::Inrun;
 use verdem::case::Case;
 use verdem::peers::{self, cross::cross_inrun};
 
@@ -58,22 +59,92 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
         );
         // the peer's contacts were there to be compared
         assert!(contacts > 0.0, "{name}: no contact stress");
-        // the wall forces of each sample are those of the saves' contacts
-        assert_eq!(saves.wall_force.len(), inrun.peer.profiles.wall_force.len());
-        for (s, w) in saves.wall_force.iter().zip(&inrun.peer.profiles.wall_force) {
+        // the wall forces of each bin (one interval of 50 steps) are the line of walls.txt at
+        // its last step, not those of the saves' contacts at that step
+        let peer_dir = out.join(peer.binary());
+        let means = wall_lines(&peer_dir.join("walls.txt"));
+        assert_eq!(
+            means.iter().map(|m| m.0).collect::<Vec<_>>(),
+            (50..=10_000).step_by(50).collect::<Vec<_>>(),
+            "{name}: the steps of walls.txt"
+        );
+        let walls = &inrun.peer.profiles.wall_force;
+        assert!(inrun.peer.profiles.wall_force_every_step, "{name}");
+        assert_eq!(walls.len(), means.len());
+        assert_eq!(saves.wall_force.len(), walls.len());
+        for ((_, m), w) in means.iter().zip(walls) {
             for g in 0..2 {
                 assert!(
-                    (s[g] - w[g]).norm() <= 1e-9 * s[g].norm().max(1.0),
-                    "{name}: saves {s:?}, in-run {w:?}"
+                    (m[g] - w[g]).norm() <= 1e-12 * m[g].norm(),
+                    "{name}: walls.txt {m:?}, in-run {w:?}"
                 );
             }
         }
         for g in 0..2 {
             assert!(
-                inrun.peer.profiles.wall_force.iter().any(|w| w[g].x != 0.0),
+                walls.iter().any(|w| w[g].x != 0.0),
                 "{name}: no force on wall {g}"
             );
+            let apart = saves
+                .wall_force
+                .iter()
+                .zip(walls)
+                .filter(|(s, w)| (s[g] - w[g]).norm() > 1e-3 * w[g].norm())
+                .count();
+            assert!(
+                apart > 0,
+                "{name}: wall {g}'s every-step means are the sampled forces"
+            );
         }
+        // verdem in the peer's convention follows the peer's trajectory over the first 2000
+        // steps (later chaos amplifies their round-off); its wall forces are its engine's
+        // impulse per step, so the two codes' every-step means agree there (LAMMPS writes them
+        // with 17 digits, LIGGGHTS with its default 6)
+        let digits = if name == "lammps" { 1e-9 } else { 1e-5 };
+        let own = &inrun.verdem_as_peer.profiles.wall_force;
+        assert!(walls[..40].iter().any(|w| w[0].x != 0.0), "{name}");
+        for (w, v) in walls[..40].iter().zip(own) {
+            for g in 0..2 {
+                assert!(
+                    (w[g] - v[g]).norm() <= digits * v[g].norm() + 1e-12,
+                    "{name}: wall {g}: peer {w:?}, verdem as the peer {v:?}"
+                );
+            }
+        }
+        // a walls.txt that lacks the last interval, or has a value that is not a number, is
+        // refused, naming the file, the line and the field
+        let sampling = peers::inrun::sampling(10_000, 50, 50);
+        let template = snapshot(&case, &state);
+        let walls_txt = peer_dir.join("walls.txt");
+        let text = std::fs::read_to_string(&walls_txt).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let n = lines.len();
+        std::fs::write(&walls_txt, lines[..n - 1].join("\n") + "\n").unwrap();
+        let profiles = |o: &CgOptions| {
+            peers::inrun::peer_profiles(peer, &peer_dir, o, &template, sampling)
+                .map(|_| ())
+                .unwrap_err()
+                .to_string()
+        };
+        let e = profiles(&o);
+        assert!(
+            e.contains("walls.txt")
+                && e.contains(&format!(
+                    "line {}: column 1 (step): the last step 9950",
+                    n - 1
+                ))
+                && e.contains("needs 200"),
+            "{name}: {e}"
+        );
+        let mut broken = lines.clone();
+        let line = broken[5].replacen(' ', " 1.5.7 ", 1);
+        broken[5] = &line;
+        std::fs::write(&walls_txt, broken.join("\n") + "\n").unwrap();
+        let e = profiles(&o);
+        assert!(
+            e.contains("walls.txt:6: column 2 (bottom fx): not a number"),
+            "{name}: {e}"
+        );
         // the particle dumps are removed once read, the files of the table are written
         assert!(!out.join(peer.binary()).join("particles.50.txt").exists());
         for csv in [peer.binary(), "verdem", "verdem_own"] {
@@ -103,6 +174,91 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
             "{name}: {e}"
         );
     }
+}
+
+/// Contacts sampled every step (K = 1) over 300 steps, in which the bottom wall is hit from step
+/// ~270: `fix ave/time 1 1 1` also writes the set-up forces at step 0, which lie outside the
+/// window and are not booked; every step's force on the walls equals that of verdem in the
+/// peer's convention (its engine's impulse per step, same trajectory), and differs from the
+/// sampled one, which the peer's contact dump re-evaluates at the end of the step with
+/// full-step velocities in the dashpots (the step itself used half-step velocities).
+#[test]
+fn a_peers_wall_forces_are_every_steps_mean_also_when_every_step_is_sampled() {
+    let (case, state) = steady();
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["lammps", "liggghts"] {
+        let peer = peers::by_name(name).unwrap();
+        let out = dir.path().join(peer.binary());
+        let r = cross_inrun(
+            peer,
+            &case,
+            peer.convention(),
+            &state,
+            300,
+            150,
+            1,
+            &out,
+            Some((1, 150)),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        let inrun = r.inrun.expect("in-run profiles");
+        let steps: Vec<u64> = wall_lines(&out.join(peer.binary()).join("walls.txt"))
+            .iter()
+            .map(|m| m.0)
+            .collect();
+        assert_eq!(steps, (0..=300).collect::<Vec<_>>(), "{name}");
+        let (walls, own) = (
+            &inrun.peer.profiles.wall_force,
+            &inrun.verdem_as_peer.profiles.wall_force,
+        );
+        assert_eq!((walls.len(), own.len()), (2, 2), "{name}");
+        assert!(walls[1][0].x != 0.0, "{name}: the bottom wall was not hit");
+        let digits = if name == "lammps" { 1e-9 } else { 1e-5 };
+        for (w, v) in walls.iter().zip(own) {
+            for g in 0..2 {
+                assert!(
+                    (w[g] - v[g]).norm() <= digits * v[g].norm() + 1e-12,
+                    "{name}: wall {g}: peer {w:?}, verdem as the peer {v:?}"
+                );
+            }
+        }
+        // the same run's forces at the samples (every step), from its contact dumps (the
+        // particle dumps are removed once read: the particle fields here are the template's,
+        // only the walls are compared)
+        let template = snapshot(&case, &state);
+        let o = CgOptions::for_case(&case);
+        let sampling = peers::inrun::sampling(300, 1, 150);
+        let mut sampled = Inrun::new(&o, &template.domain, sampling).unwrap();
+        for step in 1..=300 {
+            let s = peer
+                .read_sample(&out.join(peer.binary()), step, &template, false)
+                .unwrap_or_else(|e| panic!("{name}: step {step}: {e:#}"));
+            sampled.sample(&s, step % 150 == 0);
+        }
+        let sampled = sampled.result().unwrap();
+        assert!(!sampled.profiles.wall_force_every_step);
+        let (a, b) = (sampled.profiles.wall_force[1][0], walls[1][0]);
+        assert!(
+            (a - b).norm() > 1e-6 * b.norm() && (a - b).norm() < 0.1 * b.norm(),
+            "{name}: bottom wall, sampled {a:?}, every step {b:?}"
+        );
+    }
+}
+
+/// The lines of a peer's `walls.txt`, read here on their own: the step and the two walls'
+/// forces of each line after the `#` comments.
+fn wall_lines(path: &std::path::Path) -> Vec<(u64, [verdem::Vec3; 2])> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            assert_eq!(v.len(), 7, "{}: {l}", path.display());
+            let f = |k: usize| verdem::Vec3::new(v[k], v[k + 1], v[k + 2]);
+            (v[0] as u64, [f(1), f(4)])
+        })
+        .collect()
 }
 
 /// verdem's state of `case` from `state`, its forces evaluated.

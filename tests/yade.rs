@@ -125,8 +125,10 @@ fn a_short_cross_run_agrees_to_round_off_in_yades_convention_only() {
 /// every sample is read; Yade and verdem in its convention follow the same trajectory to
 /// round-off over these steps, so their in-run profiles agree to round-off in every column
 /// (which fails if a dump is taken at another instant than the step's forces, or with half-step
-/// velocities); the walls' forces are those of the dumped contacts (the force on each wall
-/// sphere, summed per wall, averaged per bin); verdem in MercuryDPM's convention has a core
+/// velocities); the walls' forces are every step's mean from `walls.txt` (the means of its
+/// lines per bin), equal to verdem's from its engine's impulse, and not those of the dumped
+/// contacts at the samples (the force on each wall sphere, summed per wall, averaged per bin);
+/// a `walls.txt` with a line missing is refused, naming the file and line; verdem in MercuryDPM's convention has a core
 /// pressure of the same sign within 20 % (the conventions differ by clipping and the tangential
 /// cap, a few per cent over 1e6 steps, `golden/peers/compare_inrun.md`); a contact whose body
 /// the position dump lacks is refused, by file.
@@ -195,16 +197,52 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
             }
         }
     }
-    assert_eq!(peer.profiles.wall_force.len(), 32);
-    for (want, got) in bins.iter().zip(&peer.profiles.wall_force) {
+    assert!(bins.iter().any(|w| w[0].x != 0.0) && bins.iter().any(|w| w[1].x != 0.0));
+    let walls = &peer.profiles.wall_force;
+    assert!(peer.profiles.wall_force_every_step);
+    assert_eq!(walls.len(), 32);
+    // walls.txt: a line every k steps, three per bin
+    let text = std::fs::read_to_string(yade_dir.join("walls.txt")).unwrap();
+    let lines: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split_whitespace().map(|t| t.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(lines.len(), 96);
+    for (b, got) in walls.iter().enumerate() {
+        let mut want = [Vec3::zeros(); 2];
+        for v in &lines[3 * b..3 * b + 3] {
+            assert_eq!(v.len(), 7);
+            want[0] += Vec3::new(v[1], v[2], v[3]) / per_bin;
+            want[1] += Vec3::new(v[4], v[5], v[6]) / per_bin;
+        }
+        assert_eq!(lines[3 * b + 2][0], ((b as u64 + 1) * kp) as f64);
         for g in 0..2 {
             assert!(
-                (want[g] - got[g]).norm() <= 1e-9 * want[g].norm().max(1.0),
-                "wall {g}: from the dumps {want:?}, in-run {got:?}"
+                (want[g] - got[g]).norm() <= 1e-12 * want[g].norm(),
+                "wall {g}: walls.txt {want:?}, in-run {got:?}"
             );
         }
     }
-    assert!(bins.iter().any(|w| w[0].x != 0.0) && bins.iter().any(|w| w[1].x != 0.0));
+    for g in 0..2 {
+        let apart = bins
+            .iter()
+            .zip(walls)
+            .filter(|(s, w)| (s[g] - w[g]).norm() > 1e-3 * w[g].norm())
+            .count();
+        assert!(
+            apart > 0,
+            "wall {g}'s every-step means are the sampled forces"
+        );
+    }
+    for (w, v) in walls.iter().zip(&own.profiles.wall_force) {
+        for g in 0..2 {
+            assert!(
+                (w[g] - v[g]).norm() <= 1e-9 * v[g].norm() + 1e-12,
+                "wall {g}: yade {w:?}, verdem as yade {v:?}"
+            );
+        }
+    }
     // verdem in MercuryDPM's convention: the core pressure of the same sign and within 20 %
     let pressure = |res| verdem::analysis::difference::CoreMean::of(res, "pressure").mean;
     let (p_yade, p_own) = (pressure(peer), pressure(&inrun.verdem));
@@ -237,4 +275,77 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
         e.contains("positions.400.txt") && e.contains("missing"),
         "{e}"
     );
+    // a walls.txt without its line of step 200 is refused, naming the file and the line
+    let walls_txt = yade_dir.join("walls.txt");
+    let text = std::fs::read_to_string(&walls_txt).unwrap();
+    let kept: Vec<&str> = text.lines().filter(|l| !l.starts_with("200 ")).collect();
+    std::fs::write(&walls_txt, kept.join("\n") + "\n").unwrap();
+    let e = peers::inrun::peer_profiles(
+        yade(),
+        &yade_dir,
+        &verdem::analysis::cg::CgOptions::for_case(&case),
+        &template,
+        peers::inrun::sampling(4800, k, kp),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("walls.txt:5: column 1 (step): step 250, expected 200"),
+        "{e}"
+    );
+}
+
+/// Contacts sampled every step (K = 1) over 300 steps, in which the bottom wall is hit from step
+/// ~270: the walls' every-step means of `walls.txt` are then the means of the forces of the
+/// contacts dumped at every step (both are the forces of the step's InteractionLoop), to
+/// round-off.
+#[test]
+fn yades_wall_forces_every_step_are_its_sampled_ones_when_every_step_is_sampled() {
+    use verdem::analysis::inrun::Inrun;
+    use verdem::peers::cross::cross_inrun;
+    let case = Case::load(&common::root().join("cases/shear_flow.toml")).unwrap();
+    let state = common::root().join("golden/full_run/shear_flow.final.data");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("inrun");
+    let r = cross_inrun(
+        yade(),
+        &case,
+        yade().convention(),
+        &state,
+        300,
+        150,
+        1,
+        &out,
+        Some((1, 150)),
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    let walls = &r.inrun.as_ref().expect("in-run profiles").peer.profiles;
+    assert!(walls.wall_force_every_step);
+    let walls = &walls.wall_force;
+    assert!(walls[1][0].x != 0.0, "the bottom wall was not hit");
+    // the same run's forces at the samples (every step), from its contact dumps (the particle
+    // dumps are removed once read: the particle fields here are the template's, only the walls
+    // are compared)
+    let mut template = common::engine(&case, Some(&state), Default::default()).snapshot();
+    template.contacts.clear();
+    let sampling = peers::inrun::sampling(300, 1, 150);
+    let o = verdem::analysis::cg::CgOptions::for_case(&case);
+    let mut sampled = Inrun::new(&o, &template.domain, sampling).unwrap();
+    for step in 1..=300 {
+        let s = yade()
+            .read_sample(&out.join("yade"), step, &template, false)
+            .unwrap_or_else(|e| panic!("step {step}: {e:#}"));
+        sampled.sample(&s, step % 150 == 0);
+    }
+    let sampled = sampled.result().unwrap();
+    assert!(!sampled.profiles.wall_force_every_step);
+    for (s, w) in sampled.profiles.wall_force.iter().zip(walls) {
+        for g in 0..2 {
+            assert!(
+                (s[g] - w[g]).norm() <= 1e-12 * w[g].norm().max(1e-300),
+                "wall {g}: sampled {s:?}, every step {w:?}"
+            );
+        }
+    }
 }

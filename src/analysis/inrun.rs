@@ -2,8 +2,9 @@
 //! definitions, [`Raw::add_particle`] and [`Raw::add_contact`]) accumulated while a run
 //! advances, from the engine's own contacts and forces rather than from saves: the contact
 //! stress of the contacts alive every `every` steps, the mean force each wall receives over
-//! every step (its impulse from the engine's ledger over the time; from a peer's dumps, which
-//! carry no impulse, the force at the sampled steps), and the particle fields every
+//! every step (its impulse from the engine's ledger over the time; from a peer, the means over
+//! every K steps it writes, [`Inrun::book_wall_mean`], else the force at the sampled steps),
+//! and the particle fields every
 //! `particle_every` steps. Samples go into bins of
 //! consecutive steps (at most [`MAX_BINS`]; two neighbours merge when more would be needed), and
 //! the bins are the series the profiles' standard errors are taken from, with blocks as long as
@@ -111,7 +112,7 @@ pub struct Inrun {
     wall: Vec<[Vec3; 2]>,
     /// Per bin: the impulse the free particles gave the bottom [0] and top [1] wall spheres
     /// over the steps it covers, divided by the time step (force × steps), and those steps;
-    /// zero steps when the samples come without an engine (a peer's dumps).
+    /// zero steps when the samples come without an engine or a peer's means.
     impulse: Vec<[Vec3; 2]>,
     impulse_steps: Vec<u64>,
     /// The step the engine was last observed at and the walls' impulse since its first step
@@ -311,6 +312,25 @@ impl Inrun {
             }
         }
         self.mark = Some(now);
+    }
+
+    /// Books the walls' mean force over the `steps` steps ending at step `step` (s − steps + 1..s;
+    /// `mean`: the force the free particles exert on the bottom [0] and top [1] wall spheres,
+    /// averaged over those steps, in the run's force units) into the bin of `step`, as
+    /// [`Inrun::observe`] books the engine's impulse over the same steps: `steps` × `mean` to
+    /// the bin's impulse sum, `steps` to its steps. Only an interval inside the window
+    /// (`from`, `to`] is booked; returns whether it was.
+    pub fn book_wall_mean(&mut self, step: u64, steps: u64, mean: [Vec3; 2]) -> bool {
+        let s = self.sampling;
+        if steps == 0 || step > s.to || step < s.from.saturating_add(steps) {
+            return false;
+        }
+        let b = self.bin_of(step);
+        for (j, m) in self.impulse[b].iter_mut().zip(mean) {
+            *j += m * steps as f64;
+        }
+        self.impulse_steps[b] += steps;
+        true
     }
 
     /// Halves the number of bins: bins 2j and 2j + 1 become bin j, twice as long.
@@ -829,4 +849,49 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wall mean is booked as the engine's impulse over the same steps would be: into the bin
+    /// of its last step, K times the mean with K steps, and only when all its steps are in
+    /// (`from`, `to`].
+    #[test]
+    fn a_wall_mean_is_booked_only_inside_the_window_into_its_last_steps_bin() {
+        let domain = Domain::new(
+            Vec3::zeros(),
+            Vec3::new(20.0, 20.0, 22.0),
+            [true, true, false],
+        );
+        let sampling = Sampling {
+            every: 10,
+            particle_every: 20,
+            from: 100,
+            to: 200,
+        };
+        let mut acc = Inrun::new(&CgOptions::default(), &domain, sampling).unwrap();
+        let mean = [Vec3::new(1.0, 2.0, -3.0), Vec3::new(-0.5, 0.0, 4.0)];
+        // steps 91..=100 end at `from`, 96..=105 start before it, 201..=210 end after `to`
+        assert!(!acc.book_wall_mean(100, 10, mean));
+        assert!(!acc.book_wall_mean(105, 10, mean));
+        assert!(!acc.book_wall_mean(210, 10, mean));
+        assert!(!acc.book_wall_mean(150, 0, mean));
+        assert!(acc.bins.is_empty());
+        // the first steps after `from` and the last ones up to `to`: bins 0 and 4 of 20 steps
+        assert!(acc.book_wall_mean(110, 10, mean));
+        assert!(acc.book_wall_mean(120, 10, mean));
+        assert!(acc.book_wall_mean(200, 10, mean));
+        assert_eq!(acc.impulse_steps, vec![20, 0, 0, 0, 10]);
+        for g in 0..2 {
+            assert_eq!(acc.impulse[0][g], mean[g] * 20.0);
+            assert_eq!(acc.impulse[4][g], mean[g] * 10.0);
+            assert_eq!(acc.impulse[2][g], Vec3::zeros());
+        }
+        // one interval of the whole window
+        let mut whole = Inrun::new(&CgOptions::default(), &domain, sampling).unwrap();
+        assert!(whole.book_wall_mean(200, 100, mean));
+        assert_eq!(whole.impulse_steps, vec![0, 0, 0, 0, 100]);
+    }
 }

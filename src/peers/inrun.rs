@@ -11,15 +11,102 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use anyhow::Context;
+use anyhow::{ensure, Context};
 
 use super::Peer;
 use crate::analysis::cg::CgOptions;
 use crate::analysis::difference::Difference;
 use crate::analysis::inrun::{Inrun, InrunResult, Sampling};
+use crate::io::{parse_fields, read_text, FormatError};
 use crate::run::Observer;
 use crate::state::Snapshot;
 use crate::step::Engine;
+use crate::Vec3;
+
+/// The file of a peer's in-run folder with the walls' every-step mean forces
+/// ([`read_wall_means`]).
+pub const WALLS_FILE: &str = "walls.txt";
+
+/// The columns of [`WALLS_FILE`].
+const WALL_COLUMNS: [&str; 7] = [
+    "step",
+    "bottom fx",
+    "bottom fy",
+    "bottom fz",
+    "top fx",
+    "top fy",
+    "top fz",
+];
+
+/// One line of [`WALLS_FILE`]: the walls' mean force over the K steps ending at `step`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallMean {
+    /// Its line in the file (from 1).
+    pub line: usize,
+    pub step: u64,
+    /// The mean over steps `step` − K + 1..=`step` of the force the free particles exert on the
+    /// bottom [0] and top [1] wall spheres (force units).
+    pub force: [Vec3; 2],
+}
+
+/// The walls' every-step mean forces of `path` ([`WALLS_FILE`]) written every `every` steps:
+/// after `#` comment lines, one line per interval, the step s and the mean over steps
+/// s − `every` + 1..=s of the force on the bottom wall's spheres (x, y, z), then the top wall's.
+/// A line without seven finite numbers, a step that is not a whole multiple of `every`, or a
+/// step other than the previous line's plus `every` is refused, naming the line and field.
+pub fn read_wall_means(path: &Path, every: u64) -> Result<Vec<WallMean>, FormatError> {
+    let (file, text) = read_text(path)?;
+    let err = |line: usize, msg: String| FormatError {
+        file: file.clone(),
+        line,
+        msg,
+    };
+    let mut out: Vec<WallMean> = Vec::new();
+    let mut v = Vec::new();
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let t = raw.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        parse_fields(&file, line, t, &WALL_COLUMNS, &mut v)?;
+        if v.len() != WALL_COLUMNS.len() {
+            return Err(err(
+                line,
+                format!(
+                    "{} numbers, expected {} ({})",
+                    v.len(),
+                    WALL_COLUMNS.len(),
+                    WALL_COLUMNS.join(", ")
+                ),
+            ));
+        }
+        let step = v[0];
+        if step < 0.0 || step.fract() != 0.0 || step > u64::MAX as f64 {
+            return Err(err(
+                line,
+                format!("column 1 (step): {step} is not a step number"),
+            ));
+        }
+        let step = step as u64;
+        let expected = out.last().map(|m| m.step + every);
+        if expected.is_some_and(|e| e != step) || !step.is_multiple_of(every.max(1)) {
+            return Err(err(
+                line,
+                format!(
+                    "column 1 (step): step {step}, expected {} (a mean every {every} steps)",
+                    expected.map_or(format!("a multiple of {every}"), |e| e.to_string())
+                ),
+            ));
+        }
+        out.push(WallMean {
+            line,
+            step,
+            force: [Vec3::new(v[1], v[2], v[3]), Vec3::new(v[4], v[5], v[6])],
+        });
+    }
+    Ok(out)
+}
 
 /// The sampling of a cross-run of `steps` steps: contact stress and wall forces every `every`
 /// steps, particle fields every `particle_every` steps (a multiple of `every`), at steps
@@ -35,7 +122,10 @@ pub fn sampling(steps: u64, every: u64, particle_every: u64) -> Sampling {
 
 /// The in-run profiles of `peer`'s run in `dir` (made by [`Peer::inrun_script`] with the
 /// intervals of `sampling`): its sample at every sampling step, read as a state of `template`
-/// ([`Peer::read_sample`]), added to an accumulator of the coarse-graining `o`.
+/// ([`Peer::read_sample`]), added to an accumulator of the coarse-graining `o`, with the walls'
+/// every-step means of [`Peer::wall_means`] when the peer has them (else the wall forces are
+/// those at the contact samples). A file of means that lacks an interval of the window is
+/// refused, naming it.
 pub fn peer_profiles(
     peer: &dyn Peer,
     dir: &Path,
@@ -44,6 +134,9 @@ pub fn peer_profiles(
     sampling: Sampling,
 ) -> anyhow::Result<InrunResult> {
     let mut acc = Inrun::new(o, &template.domain, sampling)?;
+    if let Some(means) = peer.wall_means(dir, sampling.every) {
+        book_wall_means(&mut acc, &dir.join(WALLS_FILE), &means?)?;
+    }
     let mut step = sampling.from;
     while let Some(next) = acc.next_after(step) {
         step = next;
@@ -63,14 +156,40 @@ pub fn peer_profiles(
     })
 }
 
+/// Books the walls' means `means` of `file` ([`read_wall_means`]) into `acc`
+/// ([`Inrun::book_wall_mean`]): those of the intervals inside its window, which must all be
+/// there.
+fn book_wall_means(acc: &mut Inrun, file: &Path, means: &[WallMean]) -> anyhow::Result<()> {
+    let s = acc.sampling();
+    let booked = means
+        .iter()
+        .filter(|m| acc.book_wall_mean(m.step, s.every, m.force))
+        .count() as u64;
+    let needed = s.to / s.every - s.from.div_ceil(s.every);
+    let last = means.last().map_or("no line of means".to_string(), |m| {
+        format!("line {}: column 1 (step): the last step {}", m.line, m.step)
+    });
+    ensure!(
+        booked == needed,
+        "{}: {last}; {booked} means of {} steps in steps {}..={}, the in-run window needs {needed}",
+        file.display(),
+        s.every,
+        s.from + 1,
+        s.to
+    );
+    Ok(())
+}
+
 /// Advances `e` by `steps` steps, stopping at the steps `observer` asks for and showing it the
-/// engine there, its forces evaluated (as `verdem run` does); where it stops does not change
-/// the steps.
+/// engine there, its forces evaluated (as `verdem run` does: the observer first looks at the
+/// step it starts from, where an in-run accumulator marks the walls' impulse); where it stops
+/// does not change the steps.
 pub fn advance_observed(
     e: &mut dyn Engine,
     steps: u64,
     observer: &mut dyn Observer,
 ) -> anyhow::Result<()> {
+    observer.start(e);
     let end = e.state().step + steps;
     while e.state().step < end {
         let step = e.state().step;
@@ -94,8 +213,8 @@ pub fn markdown(rows: &[(String, String, Vec<Difference>)]) -> String {
          (in-run averaging, docs/statistics.md); Δ = A − B with its 95 % interval (Student's t, \
          Welch's degrees of freedom); real = the interval excludes 0; χ²/dof of the profiles \
          over the core slices (1 = noise); the walls' mean x-force per area (on the wall \
-         from the free spheres: verdem's the mean over every step, from its impulse; a peer's \
-         at the contact samples). \"errors too small\": a field whose blocks are shorter than \
+         from the free spheres, the mean over every step: verdem's from its impulse, a peer's \
+         from its walls.txt). \"errors too small\": a field whose blocks are shorter than \
          its correlation asks, whose interval is then too narrow.\n\n\
          | A | B | profile | A core mean | B core mean | Δ (95 % interval) | Δ / B | χ²/dof | real? |\n\
          |---|---|---|---|---|---|---|---|---|\n",

@@ -15,6 +15,8 @@ impl Dialect for Lammps {
     const BINARY: &'static str = "lmp";
     const CONVENTION: Tangential = Tangential::LammpsGranular;
     const CONTACT_COLUMNS: usize = 6;
+    /// `fix ave/time … format " %.17g"` (its default is `%g` after a space).
+    const WALLS_FORMAT: Option<&'static str> = Some("\" %.17g\"");
 
     /// The tangential damping is given relative to the normal one (`eta_t = x * eta_n`).
     fn setup_and_law(case: &Case, data: &str) -> String {

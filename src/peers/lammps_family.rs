@@ -19,6 +19,7 @@ use anyhow::{bail, ensure, Context};
 
 pub mod dump;
 
+use super::inrun::{read_wall_means, WallMean, WALLS_FILE};
 use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::atomic;
@@ -40,6 +41,10 @@ pub trait Dialect: Sync {
     /// The script from its units to its neighbour settings: units, atom style, boundary,
     /// `read_data data`, the groups ([`GROUPS`]) and the contact law of `case`.
     fn setup_and_law(case: &Case, data: &str) -> String;
+
+    /// The value of `fix ave/time`'s `format` keyword that prints each number with 17
+    /// significant digits after a space; `None` when the code has no such keyword.
+    const WALLS_FORMAT: Option<&'static str>;
 
     /// The `dump_modify` keywords that print every float of a [`DUMP_COLUMNS`] line with 17
     /// significant digits.
@@ -153,11 +158,32 @@ dump_modify     traj sort id {}\n\
     )
 }
 
+/// The walls' every-step mean forces of in-run averaging: `compute reduce sum` of the per-atom
+/// force over the groups `bottom` and `top`, averaged by `fix ave/time 1 K K` over every step
+/// and written every K = `contact_every` steps to [`WALLS_FILE`]: at step s the mean over steps
+/// s − K + 1..s (with K = 1 also a line at step 0, the set-up forces) of the force on the
+/// bottom wall's spheres (x, y, z), then the top wall's, in `format` (`None`: the code's
+/// default). The per-atom force of a wall sphere at the end of a step is the pair style's alone:
+/// `fix move linear` with all three velocities given sets x and v and only reads f (LAMMPS
+/// `src/fix_move.cpp`, `initial_integrate`/`final_integrate`; LIGGGHTS has the same fix), and
+/// wall–wall pairs are excluded ([`neighbor`]), so it is the force the free spheres exert on
+/// the wall.
+fn wall_means(contact_every: u64, format: Option<&str>) -> String {
+    let k = contact_every;
+    let format = format.map_or(String::new(), |f| format!(" format {f}"));
+    format!(
+        "compute         inrun_fb bottom reduce sum fx fy fz\n\
+compute         inrun_ft top reduce sum fx fy fz\n\
+fix             inrun_walls all ave/time 1 {k} {k} c_inrun_fb[1] c_inrun_fb[2] c_inrun_fb[3] \
+c_inrun_ft[1] c_inrun_ft[2] c_inrun_ft[3] file {WALLS_FILE}{format}\n"
+    )
+}
+
 /// The dumps of in-run averaging besides the contact dump: every `contact_every` steps the
 /// spheres with a contact (`compute contact/atom`, kept by `dump_modify thresh`; LAMMPS and
 /// LIGGGHTS docs, `compute contact/atom`, `dump_modify`) in `positions.STEP.txt`, every
 /// `particle_every` steps all particles in `particles.STEP.txt`; the columns and format of a
-/// save's dump.
+/// save's dump; the walls' every-step mean forces ([`wall_means`]).
 fn inrun_dumps<D: Dialect>(contact_every: u64, particle_every: u64) -> String {
     let columns = DUMP_COLUMNS.join(" ");
     let format = D::dump_format();
@@ -166,7 +192,9 @@ fn inrun_dumps<D: Dialect>(contact_every: u64, particle_every: u64) -> String {
 dump            inrun_x all custom {contact_every} positions.*.txt {columns}\n\
 dump_modify     inrun_x thresh c_inrun_nc > 0 sort id {format}\n\
 dump            inrun_p all custom {particle_every} particles.*.txt {columns}\n\
-dump_modify     inrun_p sort id {format}\n"
+dump_modify     inrun_p sort id {format}\n\
+{}",
+        wall_means(contact_every, D::WALLS_FORMAT)
     )
 }
 
@@ -404,6 +432,11 @@ impl<D: Dialect> Peer for D {
             hint: " (compute contact/atom did not count it)",
         };
         placed_contacts(self, dir, step, s, (&path, placed), &atoms)
+    }
+
+    /// [`WALLS_FILE`] of `fix ave/time` ([`wall_means`]).
+    fn wall_means(&self, dir: &Path, contact_every: u64) -> Option<anyhow::Result<Vec<WallMean>>> {
+        Some(read_wall_means(&dir.join(WALLS_FILE), contact_every).map_err(Into::into))
     }
 
     /// The fixed spheres (types 2 and 3) are held still by `fix move`.

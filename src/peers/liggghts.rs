@@ -14,6 +14,9 @@ impl Dialect for Liggghts {
     const BINARY: &'static str = "liggghts";
     const CONVENTION: Tangential = Tangential::Liggghts;
     const CONTACT_COLUMNS: usize = 5;
+    /// LIGGGHTS 3.8 refuses `fix ave/time`'s `format` keyword ("Illegal fix ave/time
+    /// command"): its means keep the default `%g`, 6 significant digits.
+    const WALLS_FORMAT: Option<&'static str> = None;
 
     /// Each coefficient is a `property/global` for all 3×3 pairs of atom types;
     /// `contact_distance_factor 1.01` resets a tangential spring when its contact ends.

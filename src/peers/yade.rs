@@ -29,7 +29,7 @@ use std::process::Command;
 
 use anyhow::{bail, ensure, Context};
 
-use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
+use super::{inrun, placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
@@ -256,7 +256,9 @@ impl Peer for Yade {
     /// The save runner fires every `contact_every` steps and also writes, besides the saves,
     /// the contacts (`contacts.STEP.txt`, as a save's) and the positions of the bodies they
     /// join (`positions.STEP.txt`), and every `particle_every` steps all bodies
-    /// (`particles.STEP.txt`, as `save.STEP.txt`), all at the instant of a save (`run.py`).
+    /// (`particles.STEP.txt`, as `save.STEP.txt`), all at the instant of a save; a runner every
+    /// step writes the walls' mean force over every `contact_every` steps to
+    /// [`inrun::WALLS_FILE`] (`run.py`).
     fn inrun_script(
         &self,
         case: &Case,
@@ -294,6 +296,17 @@ impl Peer for Yade {
                 ),
             )
         }))
+    }
+
+    /// [`inrun::WALLS_FILE`] of the runner `walls()` of `run.py`.
+    fn wall_means(
+        &self,
+        dir: &Path,
+        contact_every: u64,
+    ) -> Option<anyhow::Result<Vec<inrun::WallMean>>> {
+        Some(
+            inrun::read_wall_means(&dir.join(inrun::WALLS_FILE), contact_every).map_err(Into::into),
+        )
     }
 
     /// `particles.STEP.txt` for all bodies, `positions.STEP.txt` for the bodies in contact

@@ -20,7 +20,11 @@
 # In-run dumps (contact_every > 0), taken at the same instant by the same runner: every
 # contact_every steps the contacts (contacts.n.txt, as a save's) and the positions of the bodies
 # they join (positions.n.txt), every particle_every steps all bodies (particles.n.txt, as
-# save.n.txt).
+# save.n.txt). Every step a runner between the InteractionLoop and the NewtonIntegrator (the
+# forces of that step, before the ForceResetter of the next) adds the force on each wall's
+# bodies (O.forces: the force on the body) to a running sum, and every contact_every = K steps
+# writes its mean to walls.txt: at step n, the mean over steps n - K + 1..n of the bottom wall's
+# force (x, y, z), then the top wall's, as the LAMMPS family's `fix ave/time`.
 import math
 import time
 
@@ -57,6 +61,10 @@ def cell_edges(rows):
     return edges
 
 
+# The ids of the bottom [0] and top [1] walls' bodies.
+WALL_IDS = ([], [])
+
+
 def build_scene(rows):
     if any(P["periodic"]):
         O.periodic = True
@@ -78,7 +86,9 @@ def build_scene(rows):
             if P["wall_vx"] is not None:
                 b.state.vel = Vector3(P["wall_vx"][kind - 1], 0.0, 0.0)
                 b.state.angVel = Vector3(0.0, 0.0, 0.0)
-        O.bodies.append(b)
+        i = O.bodies.append(b)
+        if kind != KIND_FREE:
+            WALL_IDS[kind - 1].append(i)
 
 
 CHECKED = []
@@ -204,6 +214,30 @@ def dump():
             write_bodies("particles.%d.txt" % n, n)
 
 
+AXES = (Vector3(1, 0, 0), Vector3(0, 1, 0), Vector3(0, 0, 1))
+WALL_SUMS = [0.0] * 6
+
+
+def walls():
+    """Adds this step's force on each wall's bodies (utils.sumForces, summed in C++) to
+    WALL_SUMS; every contact_every steps appends their mean to walls.txt and restarts them. The
+    set-up forces of iteration 0 belong to no step."""
+    n = O.iter
+    if n == 0:
+        with open("walls.txt", "w") as f:
+            f.write("# step, then the mean over the last %d steps of the force on the bottom wall "
+                    "(fx fy fz), then on the top wall\n" % P["contact_every"])
+        return
+    for g, ids in enumerate(WALL_IDS):
+        for k, axis in enumerate(AXES):
+            WALL_SUMS[3 * g + k] += utils.sumForces(ids, axis)
+    if n % P["contact_every"] == 0:
+        k = float(P["contact_every"])
+        with open("walls.txt", "a") as f:
+            f.write("%d %s\n" % (n, " ".join(repr(s / k) for s in WALL_SUMS)))
+        WALL_SUMS[:] = [0.0] * 6
+
+
 FORCE_STEPS = []
 
 
@@ -225,6 +259,8 @@ engines = [
     InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
                     [Law2_ScGeom_ViscElPhys_Basic()]),
 ]
+if P["contact_every"] > 0:
+    engines.append(PyRunner(command="walls()", iterPeriod=1, initRun=True))
 if P["every"] > 0:
     period = P["contact_every"] if P["contact_every"] > 0 else P["every"]
     engines.append(PyRunner(command="dump()", iterPeriod=period, initRun=True))
