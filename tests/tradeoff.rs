@@ -271,56 +271,62 @@ fn the_recorded_trade_says_what_the_docs_say() {
             b.diff.errors_trusted(),
         )
     };
-    // the control fails: 2 of its 5 intervals contain 0; vx and T miss with errors too small,
-    // the pressure with trusted ones
+    // six replicas of each variant that changes the physics; one of each that gives the
+    // reference's bits
+    for name in [REFERENCE, CONTROL, "dt=tc/25", "kn/100"] {
+        assert_eq!(by(name).replicas, 6, "{name}");
+    }
+    for name in ["skin=0.05", "skin=0.2", "2 threads"] {
+        assert_eq!(by(name).replicas, 1, "{name}");
+    }
+    // the control passes: all 5 of its intervals contain 0
     let control = tradeoff::biases(by(CONTROL), reference, speed);
-    assert_eq!(tradeoff::coverage(&control), (2, 5));
-    assert!(!tradeoff::control_passes(&control));
-    let missed: Vec<(&str, bool)> = control
-        .iter()
-        .filter(|b| !b.contains_zero())
-        .map(|b| (b.diff.field, b.diff.errors_trusted()))
-        .collect();
-    assert_eq!(missed, [("vx", false), ("T", false), ("pressure", true)]);
+    assert_eq!(tradeoff::coverage(&control), (5, 5));
+    assert!(tradeoff::control_passes(&control));
     let coverage = Some(tradeoff::coverage(&control));
-    let physics = ["dt=tc/25", "dt=tc/100", "dt=tc/200", "kn/10", "kn/100"];
-    for name in physics {
-        let o = by(name);
-        let b = tradeoff::biases(o, reference, speed);
-        // so no verdict is settled ...
+    // softer contacts cost pressure: kn/100 in pressure (lower) and shear stress (toward 0),
+    // kn/10 in pressure only; both keep vx, ν and T, ν's interval within ±0.25 %
+    for (name, costly) in [
+        ("kn/10", vec!["pressure"]),
+        ("kn/100", vec!["pressure", "shear"]),
+    ] {
+        let b = tradeoff::biases(by(name), reference, speed);
         let shown = tradeoff::judged(&b, false, RECORDED_RESOLUTION, coverage);
-        assert!(
-            shown.starts_with("undecided: the control fails"),
-            "{name}: {shown}"
-        );
-        // ... though at face value each costs in pressure (lower) and shear stress (higher),
-        // the signs of the control's own offsets
+        assert!(shown.starts_with("**costs**"), "{name}: {shown}");
         match verdict(name) {
             Call::Costs(c) => {
                 let fields: Vec<&str> = c.iter().map(|c| c.0).collect();
-                assert_eq!(fields, ["pressure", "shear"], "{name}");
-                assert!(c[0].1 < 0.0 && c[1].1 > 0.0, "{name}: {c:?}");
+                assert_eq!(fields, costly, "{name}");
+                assert!(c[0].1 < 0.0, "{name}: {c:?}");
+                assert!(c.iter().skip(1).all(|c| c.1 > 0.0), "{name}: {c:?}");
             }
             other => panic!("{name}: {other}"),
         }
+        let (nu, h, _) = rel(name, "nu");
+        assert!(nu.abs() + h < 0.0025, "{name}: nu {nu} ± {h}");
     }
-    assert!(rel(CONTROL, "pressure").0 < 0.0 && rel(CONTROL, "shear").0 > 0.0);
-    // the finer time steps are no closer to the reference than dt = tc/25 in pressure
-    let p25 = rel("dt=tc/25", "pressure").0.abs();
-    assert!(["dt=tc/100", "dt=tc/200"]
-        .iter()
-        .all(|n| rel(n, "pressure").0.abs() >= p25));
-    // kn/100 stands out: beyond the control's offsets by more than its half-widths
-    let (p, hp, _) = rel("kn/100", "pressure");
-    let (t, ht, _) = rel("kn/100", "shear");
-    assert!(p < rel(CONTROL, "pressure").0 - hp, "{p} ± {hp}");
-    assert!(t > rel(CONTROL, "shear").0 + ht, "{t} ± {ht}");
-    for name in physics {
-        if name != "kn/100" {
-            assert!(
-                rel(name, "pressure").0 > p && rel(name, "shear").0 < t,
-                "{name}"
-            );
+    // the time steps: every interval contains 0, vx and ν biases under 0.2 % with intervals of
+    // at most ±0.32 %, T, p and τ intervals of ±1.9–3.1 %, so undecided at ±2 % through T and τ
+    for name in ["dt=tc/25", "dt=tc/100", "dt=tc/200"] {
+        let b = tradeoff::biases(by(name), reference, speed);
+        assert!(b.iter().all(|b| b.contains_zero()), "{name}");
+        for field in ["vx", "nu"] {
+            let (x, h, _) = rel(name, field);
+            assert!(x.abs() < 0.002 && h <= 0.0032, "{name} {field}: {x} ± {h}");
+        }
+        for field in ["T", "pressure", "shear"] {
+            let (_, h, _) = rel(name, field);
+            assert!((0.0185..0.0315).contains(&h), "{name} {field}: ± {h}");
+        }
+        match verdict(name) {
+            Call::Undecided { wide, .. } => {
+                let fields: Vec<&str> = wide.iter().map(|w| w.0).collect();
+                assert!(
+                    fields.contains(&"T") && fields.contains(&"shear"),
+                    "{name}: {fields:?}"
+                );
+            }
+            other => panic!("{name}: {other}"),
         }
     }
     // skin and threads change no bit: free
@@ -339,8 +345,8 @@ fn the_recorded_trade_says_what_the_docs_say() {
         assert!(cpu(name) > steps(name) && cpu(name) < 1.0, "{name}");
     }
     assert!(cpu("kn/100") > 2.0 * steps("kn/100"));
-    assert!(cpu("skin=0.05") < 0.85 && cpu("skin=0.2") > 1.0);
-    assert!(cpu("2 threads") > 1.5);
+    assert!(cpu("skin=0.05") < 0.95 && cpu("skin=0.2") > 1.0);
+    assert!(cpu("2 threads") > 1.3);
     // the restitution error halves with each halving of dt; softer contacts keep it
     let e = |name: &str| by(name).restitution_error.abs();
     for (coarse, fine) in [

@@ -552,11 +552,25 @@ pub fn judged(
 /// 95 % interval (relative), whether it gives the reference's bits, and its verdict at
 /// `resolution`; then the control's coverage. vx is relative to `wall_speed`.
 pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> String {
+    let replicas = outcomes
+        .iter()
+        .find(|o| o.name == REFERENCE)
+        .map_or(1, |o| o.replicas);
+    let errors = if replicas >= 2 {
+        format!(
+            "each core mean's error from the spread of its {replicas} replicas' own core means, \
+             sd/√{replicas} with {} degrees of freedom; a variant that gives the reference's bits \
+             runs one",
+            replicas - 1
+        )
+    } else {
+        String::from("each core mean's error from the field's own blocks")
+    };
     let mut s = format!(
         "Bias = core mean (z in [3, 19]) of the variant − the reference's, relative to the \
          reference's (vx: to the walls' speed {wall_speed}), ± half its 95 % interval \
-         (Student's t, Welch's degrees of freedom; each core mean's error from the field's own \
-         blocks, in-run averaging over the second half of each run); † = errors too small \
+         (Student's t, Welch's degrees of freedom; {errors}; in-run averaging over the second \
+         half of each run); † = errors too small \
          (blocks shorter than the field's correlation asks: not settled). Verdict: free = every \
          interval contains 0 and is narrower than ± {}; costs = the profiles whose interval \
          excludes 0; both only when the control passes (at most one of its five intervals excludes \
