@@ -73,9 +73,23 @@ impl Config {
 /// at 80–350 ns a round trip.
 const PROBE_TRIPS: u64 = 20_000;
 
-/// A round whose probe took more than this many times the fastest probe of the bench ran with
-/// its CPUs placed far apart.
+/// The probes of a bench split into near and far placements at their widest gap when it is a
+/// ratio of more than this: the host's placements differ severalfold (~30, ~60–110 and
+/// ~320–400 ns measured here), the noise within one placement far less.
 const FAR: f64 = 2.0;
+
+/// The round trip above which a probe of `probes` (ns) counts as far: the geometric middle of
+/// the widest ratio between two consecutive sorted probes, when that ratio exceeds [`FAR`];
+/// `None` when the probes show one placement only.
+fn far_threshold(probes: &[f64]) -> Option<f64> {
+    let mut p = probes.to_vec();
+    p.sort_by(f64::total_cmp);
+    p.windows(2)
+        .filter(|w| w[0] > 0.0)
+        .max_by(|a, b| (a[1] / a[0]).total_cmp(&(b[1] / b[0])))
+        .filter(|w| w[1] / w[0] > FAR)
+        .map(|w| (w[0] * w[1]).sqrt())
+}
 
 /// Measured rates of one configuration over the rounds, and verdem's stage times.
 #[derive(Clone, Debug)]
@@ -471,22 +485,42 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
 
 /// What the core-to-core probes say of the rounds of `team` (verdem's 2 threads): the median
 /// round trip, and which rounds ran with the two CPUs far apart (a probe before or after the
-/// run over [`FAR`] times the fastest probe of any configuration of `m`) with the team's median
-/// rate in those rounds and in the others. `None` without probes.
+/// run above [`far_threshold`] of all the probes of `m`) with the team's median rate in those
+/// rounds and in the others. `None` without probes.
 fn placement(m: &[Measured], team: &Measured) -> Option<String> {
-    let fastest = m
+    let all: Vec<f64> = m
         .iter()
         .flat_map(|x| x.round_trips.iter().flatten())
         .copied()
-        .fold(f64::INFINITY, f64::min);
+        .collect();
     let probes: Vec<f64> = team.round_trips.iter().flatten().copied().collect();
     if probes.is_empty() || team.round_trips.len() != team.rates.len() {
         return None;
     }
+    let (lo, hi) = (
+        probes.iter().copied().fold(f64::INFINITY, f64::min),
+        probes.iter().copied().fold(0.0, f64::max),
+    );
+    let by_round: Vec<String> = team
+        .round_trips
+        .iter()
+        .map(|p| format!("{:.0}/{:.0}", p[0], p[1]))
+        .collect();
+    let mut line = format!(
+        "\ncore-to-core round trip around verdem's 2-thread rounds (before/after each, ns): {}; median {:.0} ns ({lo:.0}–{hi:.0} ns); ",
+        by_round.join(", "),
+        median(&probes)
+    );
+    let Some(threshold) = far_threshold(&all) else {
+        line.push_str(&format!(
+            "the bench's probes show one placement of the two CPUs (no gap between them over {FAR}×)\n"
+        ));
+        return Some(line);
+    };
     let far: Vec<bool> = team
         .round_trips
         .iter()
-        .map(|p| p[0].max(p[1]) > FAR * fastest)
+        .map(|p| p[0].max(p[1]) > threshold)
         .collect();
     let rates = |placed_far: bool| -> Vec<f64> {
         team.rates
@@ -496,26 +530,13 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
             .map(|(r, _)| *r)
             .collect()
     };
-    let (lo, hi) = (
-        probes.iter().copied().fold(f64::INFINITY, f64::min),
-        probes.iter().copied().fold(0.0, f64::max),
-    );
     let n_far = far.iter().filter(|&&f| f).count();
-    let mut line = format!(
-        "\ncore-to-core round trip around verdem's 2-thread rounds: median {:.0} ns ({lo:.0}–{hi:.0} ns; fastest probe of this bench {fastest:.0} ns); ",
-        median(&probes)
-    );
-    if n_far == 0 {
-        line.push_str("no round ran with the two CPUs placed far apart\n");
-    } else {
-        let (near, far) = (rates(false), rates(true));
-        line.push_str(&format!(
-            "{n_far} of {} rounds ran with the two CPUs placed far apart (a probe over {FAR}× the fastest): verdem 2 threads {} steps/s in those against {} in the others; the ratios above include them\n",
-            team.rates.len(),
-            rate_or_none(&far),
-            rate_or_none(&near)
-        ));
-    }
+    line.push_str(&format!(
+        "{n_far} of {} rounds ran with the two CPUs placed far apart (a probe above {threshold:.0} ns, the middle of the widest gap between the bench's probes): verdem 2 threads {} steps/s in those against {} in the others; the ratios above include them\n",
+        team.rates.len(),
+        rate_or_none(&rates(true)),
+        rate_or_none(&rates(false))
+    ));
     Some(line)
 }
 
@@ -980,18 +1001,22 @@ mod tests {
     }
 
     #[test]
-    fn rounds_whose_probe_is_far_above_the_fastest_are_named_with_their_own_rate() {
+    fn rounds_whose_probe_is_above_the_widest_gap_are_named_with_their_own_rate() {
         let one = measured(1, 1, &[100.0, 100.0, 100.0]);
         let mut two = measured(2, 1, &[130.0, 80.0, 120.0]);
-        // the second round's probe after the run is 5× the fastest (60 ns): far
+        // the second round's probe after the run, 300 ns, is beyond the widest gap (110 to 300)
         two.round_trips = vec![[60.0, 70.0], [65.0, 300.0], [90.0, 110.0]];
         let line = placement(&[one.clone(), two.clone()], &two).unwrap();
         assert!(
-            line.contains("median 80 ns (60–300 ns; fastest probe of this bench 60 ns)"),
+            line.contains(
+                "(before/after each, ns): 60/70, 65/300, 90/110; median 80 ns (60–300 ns)"
+            ),
             "{line}"
         );
         assert!(
-            line.contains("1 of 3 rounds ran with the two CPUs placed far apart"),
+            line.contains(
+                "1 of 3 rounds ran with the two CPUs placed far apart (a probe above 182 ns"
+            ),
             "{line}"
         );
         assert!(
@@ -999,18 +1024,25 @@ mod tests {
             "{line}"
         );
         assert!(markdown(&[one.clone(), two.clone()], 1).contains(&line));
-        // a faster probe elsewhere in the bench sets the scale: now two rounds are far
+        // a much faster probe elsewhere (an even nearer placement) leaves the split where the
+        // widest gap is
         let mut pair = measured(1, 2, &[200.0, 200.0, 200.0]);
-        pair.round_trips = vec![[40.0, 40.0]; 3];
+        pair.round_trips = vec![[28.0, 40.0]; 3];
+        let line = placement(&[one.clone(), two.clone(), pair.clone()], &two).unwrap();
+        assert!(line.contains("1 of 3 rounds"), "{line}");
+        // two far rounds
+        two.round_trips = vec![[330.0, 340.0], [65.0, 300.0], [90.0, 110.0]];
         let line = placement(&[one.clone(), two.clone(), pair], &two).unwrap();
         assert!(line.contains("2 of 3 rounds"), "{line}");
-        // all near, or no probes
-        two.round_trips = vec![[60.0, 70.0]; 3];
+        // one placement only, or no probes
+        two.round_trips = vec![[60.0, 70.0], [80.0, 95.0], [66.0, 61.0]];
         assert!(placement(&[two.clone()], &two)
             .unwrap()
-            .contains("no round ran with the two CPUs placed far apart"));
+            .contains("the bench's probes show one placement"));
         two.round_trips.clear();
         assert_eq!(placement(&[two.clone()], &two), None);
+        assert_eq!(far_threshold(&[]), None);
+        assert_eq!(far_threshold(&[50.0]), None);
     }
 
     #[test]
