@@ -123,7 +123,7 @@ pub fn sampling(steps: u64, every: u64, particle_every: u64) -> Sampling {
 /// The in-run profiles of `peer`'s run in `dir` (made by [`Peer::inrun_script`] with the
 /// intervals of `sampling`): its sample at every sampling step, read as a state of `template`
 /// ([`Peer::read_sample`]), added to an accumulator of the coarse-graining `o`, with the walls'
-/// every-step means of [`Peer::wall_means`] when the peer has them (else the wall forces are
+/// every-step means of its [`WALLS_FILE`] when the peer writes one ([`Peer::writes_wall_means`]) (else the wall forces are
 /// those at the contact samples). A file of means that lacks an interval of the window is
 /// refused, naming it.
 pub fn peer_profiles(
@@ -134,8 +134,9 @@ pub fn peer_profiles(
     sampling: Sampling,
 ) -> anyhow::Result<InrunResult> {
     let mut acc = Inrun::new(o, &template.domain, sampling)?;
-    if let Some(means) = peer.wall_means(dir, sampling.every) {
-        book_wall_means(&mut acc, &dir.join(WALLS_FILE), &means?)?;
+    if peer.writes_wall_means() {
+        let file = dir.join(WALLS_FILE);
+        book_wall_means(&mut acc, &file, &read_wall_means(&file, sampling.every)?)?;
     }
     let mut step = sampling.from;
     while let Some(next) = acc.next_after(step) {

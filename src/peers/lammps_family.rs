@@ -19,7 +19,7 @@ use anyhow::{bail, ensure, Context};
 
 pub mod dump;
 
-use super::inrun::{read_wall_means, WallMean, WALLS_FILE};
+use super::inrun::WALLS_FILE;
 use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::atomic;
@@ -435,8 +435,8 @@ impl<D: Dialect> Peer for D {
     }
 
     /// [`WALLS_FILE`] of `fix ave/time` ([`wall_means`]).
-    fn wall_means(&self, dir: &Path, contact_every: u64) -> Option<anyhow::Result<Vec<WallMean>>> {
-        Some(read_wall_means(&dir.join(WALLS_FILE), contact_every).map_err(Into::into))
+    fn writes_wall_means(&self) -> bool {
+        true
     }
 
     /// The fixed spheres (types 2 and 3) are held still by `fix move`.

@@ -136,17 +136,12 @@ pub trait Peer: Sync {
         bail!("{} has no in-run dumps", self.name())
     }
 
-    /// The walls' every-step mean forces of a run of [`Peer::inrun_script`] in `dir` with
-    /// contact samples every `contact_every` steps, read from its [`inrun::WALLS_FILE`]
-    /// ([`inrun::read_wall_means`]): every `contact_every` steps the mean over those steps of
-    /// the force the free particles exert on the bottom [0] and top [1] wall spheres (force
-    /// units); `None` when the peer writes no such file.
-    fn wall_means(
-        &self,
-        _dir: &Path,
-        _contact_every: u64,
-    ) -> Option<anyhow::Result<Vec<inrun::WallMean>>> {
-        None
+    /// Whether a run of [`Peer::inrun_script`] writes the walls' every-step mean forces to
+    /// [`inrun::WALLS_FILE`] in its folder ([`inrun::read_wall_means`]: every `contact_every`
+    /// steps the mean over those steps of the force the free particles exert on the bottom [0]
+    /// and top [1] wall spheres, force units).
+    fn writes_wall_means(&self) -> bool {
+        false
     }
 
     /// Whether [`Peer::read_contacts`] can give its contact forces at all (a cross-run without

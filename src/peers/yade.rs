@@ -29,7 +29,7 @@ use std::process::Command;
 
 use anyhow::{bail, ensure, Context};
 
-use super::{inrun, placed_contacts, wall_speeds, Frame, Naming, Peer};
+use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
@@ -258,7 +258,7 @@ impl Peer for Yade {
     /// join (`positions.STEP.txt`), and every `particle_every` steps all bodies
     /// (`particles.STEP.txt`, as `save.STEP.txt`), all at the instant of a save; a runner every
     /// step writes the walls' mean force over every `contact_every` steps to
-    /// [`inrun::WALLS_FILE`] (`run.py`).
+    /// [`super::inrun::WALLS_FILE`] (`run.py`).
     fn inrun_script(
         &self,
         case: &Case,
@@ -298,15 +298,9 @@ impl Peer for Yade {
         }))
     }
 
-    /// [`inrun::WALLS_FILE`] of the runner `walls()` of `run.py`.
-    fn wall_means(
-        &self,
-        dir: &Path,
-        contact_every: u64,
-    ) -> Option<anyhow::Result<Vec<inrun::WallMean>>> {
-        Some(
-            inrun::read_wall_means(&dir.join(inrun::WALLS_FILE), contact_every).map_err(Into::into),
-        )
+    /// [`super::inrun::WALLS_FILE`] of the runner `walls()` of `run.py`.
+    fn writes_wall_means(&self) -> bool {
+        true
     }
 
     /// `particles.STEP.txt` for all bodies, `positions.STEP.txt` for the bodies in contact
