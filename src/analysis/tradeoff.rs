@@ -641,13 +641,7 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
 /// standard error, blocks and whether its errors are trusted.
 pub fn csv(outcomes: &[Outcome]) -> String {
     let mut s =
-        String::from("variant,dt,steps,replicas,cpu_seconds,wall_seconds,restitution_error,hash");
-    for (field, _) in FIELDS {
-        s.push_str(&format!(
-            ",{field}_mean,{field}_se,{field}_blocks,{field}_trusted"
-        ));
-    }
-    s.push('\n');
+        core_header("variant,dt,steps,replicas,cpu_seconds,wall_seconds,restitution_error,hash");
     for o in outcomes {
         s.push_str(&format!(
             "{},{:e},{},{},{:e},{:e},{:e},{}",
@@ -660,13 +654,7 @@ pub fn csv(outcomes: &[Outcome]) -> String {
             o.restitution_error,
             o.hash
         ));
-        for c in &o.core {
-            s.push_str(&format!(
-                ",{:e},{:e},{},{}",
-                c.mean, c.se, c.blocks, c.long_enough
-            ));
-        }
-        s.push('\n');
+        push_core(&mut s, &o.core);
     }
     s
 }
@@ -676,26 +664,38 @@ pub fn csv(outcomes: &[Outcome]) -> String {
 /// [`FIELDS`] its core mean, standard error, blocks and whether its errors are trusted — what
 /// [`merge_core`] merged into [`csv`]'s row.
 pub fn replicas_csv(outcomes: &[Outcome]) -> String {
-    let mut s = String::from("variant,replica");
+    let mut s = core_header("variant,replica");
+    for o in outcomes {
+        for (k, part) in o.replica_core.iter().enumerate() {
+            s.push_str(&format!("{},{k}", o.name));
+            push_core(&mut s, part);
+        }
+    }
+    s
+}
+
+/// A CSV header line: `first`, then per profile of [`FIELDS`] its core mean, standard error,
+/// blocks and trust columns.
+fn core_header(first: &str) -> String {
+    let mut s = String::from(first);
     for (field, _) in FIELDS {
         s.push_str(&format!(
             ",{field}_mean,{field}_se,{field}_blocks,{field}_trusted"
         ));
     }
     s.push('\n');
-    for o in outcomes {
-        for (k, part) in o.replica_core.iter().enumerate() {
-            s.push_str(&format!("{},{k}", o.name));
-            for c in part {
-                s.push_str(&format!(
-                    ",{:e},{:e},{},{}",
-                    c.mean, c.se, c.blocks, c.long_enough
-                ));
-            }
-            s.push('\n');
-        }
-    }
     s
+}
+
+/// Ends a CSV row with the cells of `core` in [`core_header`]'s order.
+fn push_core(s: &mut String, core: &[CoreMean]) {
+    for c in core {
+        s.push_str(&format!(
+            ",{:e},{:e},{},{}",
+            c.mean, c.se, c.blocks, c.long_enough
+        ));
+    }
+    s.push('\n');
 }
 
 /// Reads what [`csv`] wrote (the variant's name is all before the other fields, commas
