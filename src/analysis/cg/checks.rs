@@ -2,6 +2,7 @@
 //! symmetry, steadiness across the blocks of saves, and a kinetic-theory sanity check
 //! (reported, never failed).
 
+use super::blocking::BED_DRIFT_SD;
 use super::{columns, core_range, Profiles, COLUMNS};
 use crate::analysis::stats::{block, standard_error, trend, weighted_mean_chi2};
 use crate::analysis::{Limit, Verdict};
@@ -58,32 +59,68 @@ fn col(name: &str) -> usize {
         .expect("known column")
 }
 
-/// χ²/dof of a profile against its mirror image about the mid-plane (`sign` −1 for an
-/// antisymmetric one) over the pairs of slices k and n − 1 − k, with the pairs left out. A slice
-/// whose error is not zero but below round-off of its value (blocks that differ only in their
-/// last bits: a slice the particles barely reach) has no measured error; its pair is left out
-/// and counted rather than divided by a round-off error. An error of exactly zero (identical
-/// blocks) keeps its meaning: any difference from the mirror is then real.
-fn mirror_chi2(values: &[f64], errors: &[f64], sign: f64) -> (f64, usize) {
+/// A profile against its mirror image about the mid-plane ([`mirror`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Mirror {
+    /// χ²/dof over the judged pairs (less `offset` when it was removed).
+    chi2: f64,
+    /// Pairs left out: a slice of the pair has no measured error.
+    left_out: usize,
+    /// Half the weighted mean of a_k − sign·a_(n−1−k): the uniform offset of the profile that
+    /// breaks its symmetry (0 when not removed).
+    offset: f64,
+}
+
+/// A profile against its mirror image about the mid-plane (`sign` −1 for an antisymmetric one)
+/// over the pairs of slices k and n − 1 − k, with the pairs left out; with `less_offset`, the
+/// uniform offset of the profile is fitted (weighted by the pairs' errors) and removed first,
+/// one degree of freedom fewer. A slice whose error is not zero but below round-off of its value
+/// (blocks that differ only in their last bits: a slice the particles barely reach) has no
+/// measured error; its pair is left out and counted rather than divided by a round-off error.
+/// An error of exactly zero (identical blocks) keeps its meaning: any difference from the
+/// mirror is then real.
+fn mirror(values: &[f64], errors: &[f64], sign: f64, less_offset: bool) -> Mirror {
     let n = values.len();
     let unmeasured = |k: usize| errors[k] > 0.0 && errors[k] <= 1e-9 * values[k].abs();
     let (kept, left): (Vec<usize>, Vec<usize>) =
         (0..n / 2).partition(|&k| !(unmeasured(k) || unmeasured(n - 1 - k)));
-    let sum: f64 = kept
+    let pairs: Vec<(f64, f64)> = kept
         .iter()
         .map(|&k| {
-            let (a, b) = (values[k], sign * values[n - 1 - k]);
-            let se = (errors[k].powi(2) + errors[n - 1 - k].powi(2)).sqrt();
-            if se > 0.0 {
-                ((a - b) / se).powi(2)
-            } else if a == b {
+            let d = values[k] - sign * values[n - 1 - k];
+            (d, errors[k].powi(2) + errors[n - 1 - k].powi(2))
+        })
+        .collect();
+    let weight: f64 = pairs.iter().filter(|p| p.1 > 0.0).map(|p| 1.0 / p.1).sum();
+    let shift = if less_offset && weight > 0.0 {
+        pairs
+            .iter()
+            .filter(|p| p.1 > 0.0)
+            .map(|p| p.0 / p.1)
+            .sum::<f64>()
+            / weight
+    } else {
+        0.0
+    };
+    let sum: f64 = pairs
+        .iter()
+        .map(|&(d, var)| {
+            let d = d - shift;
+            if var > 0.0 {
+                d * d / var
+            } else if d == 0.0 {
                 0.0
             } else {
                 f64::INFINITY
             }
         })
         .sum();
-    (sum / kept.len() as f64, left.len())
+    let dof = pairs.len() as f64 - if less_offset { 1.0 } else { 0.0 };
+    Mirror {
+        chi2: sum / dof,
+        left_out: left.len(),
+        offset: shift / 2.0,
+    }
 }
 
 /// Runs every check. `density` is the particle density (for the kinetic-theory check).
@@ -273,33 +310,54 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             format!("< {tol:e}"),
         ),
     );
-    // 4. Symmetry about the mid-plane.
+    // 4. Symmetry about the mid-plane. vx's is judged less its uniform offset, the bed's slow
+    //    drift that no run's errors include, and the offset against that drift's measured size.
     for (name, sign) in [("nu", 1.0), ("T", 1.0), ("pressure", 1.0), ("vx", -1.0)] {
         let c = col(name);
         let values: Vec<f64> = cols.iter().map(|row| row[c]).collect();
         let errors: Vec<f64> = p.se.iter().map(|row| row[c]).collect();
-        let (chi, left_out) = mirror_chi2(&values, &errors, sign);
-        let unmeasured_note = if left_out > 0 {
-            format!(", {left_out} pair(s) of slices without a measured error left out")
+        let drifts = sign < 0.0;
+        let m = mirror(&values, &errors, sign, drifts);
+        let unmeasured_note = if m.left_out > 0 {
+            format!(
+                ", {} pair(s) of slices without a measured error left out",
+                m.left_out
+            )
         } else {
             String::new()
         };
-        let quantity = format!(
-            "{} {name} about the mid-plane",
-            if sign > 0.0 {
-                "symmetric"
-            } else {
-                "antisymmetric"
-            }
-        );
+        let quantity = if drifts {
+            format!("antisymmetric {name} about the mid-plane, less a uniform offset")
+        } else {
+            format!("symmetric {name} about the mid-plane")
+        };
         out.push(
-            Verdict::judge("", &quantity, chi, Limit::Below(limit))
+            Verdict::judge("", &quantity, m.chi2, Limit::Below(limit))
                 .judged_if(judged)
                 .described(
-                    format!("chi2/dof = {:.2}{unmeasured_note}", Shown(chi)),
+                    format!("chi2/dof = {:.2}{unmeasured_note}", Shown(m.chi2)),
                     format!("< {limit}{unjudged}"),
                 ),
         );
+        if drifts {
+            let tol = limit * BED_DRIFT_SD;
+            out.push(
+                Verdict::judge(
+                    "",
+                    &format!("{name}'s uniform offset within the bed's drift"),
+                    m.offset.abs(),
+                    Limit::Below(tol),
+                )
+                .described(
+                    format!(
+                        "offset {:+.2e} (the bed's drift: standard deviation {BED_DRIFT_SD:.1e}, \
+                         docs/statistics.md)",
+                        Shown(m.offset)
+                    ),
+                    format!("|offset| < {tol:.2e}"),
+                ),
+            );
+        }
     }
     // 5. Steadiness: no trend of the core's fluctuation energy ½ tr σ_kin across the blocks
     //    (its name starts with STEADY, which `unsteady_note` looks for).
@@ -416,7 +474,7 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{mirror_chi2, unsteady_note, Limit, Shown, Verdict, STEADY};
+    use super::{mirror, unsteady_note, Limit, Shown, Verdict, STEADY};
 
     #[test]
     fn a_number_that_is_not_finite_is_written_as_a_word() {
@@ -453,21 +511,41 @@ mod tests {
         // six slices; slice 0 is barely reached: a value with an error of round-off
         let values = [0.0107, 1.0, 2.0, 2.1, 1.1, 0.001];
         let errors = [3e-19, 0.1, 0.1, 0.1, 0.1, 2e-4];
-        let (chi, left) = mirror_chi2(&values, &errors, 1.0);
-        assert_eq!(left, 1);
-        assert!((chi - 0.5).abs() < 1e-9, "{chi}");
+        let m = mirror(&values, &errors, 1.0, false);
+        assert_eq!(m.left_out, 1);
+        assert!((m.chi2 - 0.5).abs() < 1e-9, "{m:?}");
         // with a measured error the same slice is judged, and fails
         let measured = [1e-4, 0.1, 0.1, 0.1, 0.1, 2e-4];
-        let (chi, left) = mirror_chi2(&values, &measured, 1.0);
-        assert_eq!(left, 0);
-        assert!(chi > 100.0, "{chi}");
+        let m = mirror(&values, &measured, 1.0, false);
+        assert_eq!(m.left_out, 0);
+        assert!(m.chi2 > 100.0, "{m:?}");
         // an error of exactly zero is identical blocks: the asymmetry is real
         let exact = [0.0, 0.1, 0.1, 0.1, 0.1, 0.0];
-        let (chi, left) = mirror_chi2(&values, &exact, 1.0);
-        assert_eq!(left, 0);
-        assert!(chi.is_infinite(), "{chi}");
+        let m = mirror(&values, &exact, 1.0, false);
+        assert_eq!(m.left_out, 0);
+        assert!(m.chi2.is_infinite(), "{m:?}");
         // antisymmetric: -v mirrors v
-        let (chi, _) = mirror_chi2(&[-1.0, 0.5, -0.5, 1.0], &[0.1; 4], -1.0);
-        assert!(chi < 1e-12, "{chi}");
+        let m = mirror(&[-1.0, 0.5, -0.5, 1.0], &[0.1; 4], -1.0, false);
+        assert!(m.chi2 < 1e-12, "{m:?}");
+    }
+
+    #[test]
+    fn a_uniform_offset_breaks_antisymmetry_and_is_measured_apart() {
+        // an antisymmetric profile shifted by 0.03, errors 0.01: far from its mirror image
+        let values: Vec<f64> = [-1.0, -0.5, -0.1, 0.1, 0.5, 1.0]
+            .iter()
+            .map(|v| v + 0.03)
+            .collect();
+        let errors = [0.01; 6];
+        assert!(mirror(&values, &errors, -1.0, false).chi2 > 10.0);
+        // less the offset it is antisymmetric, and the offset is the shift
+        let m = mirror(&values, &errors, -1.0, true);
+        assert!(m.chi2 < 1e-20, "{m:?}");
+        assert!((m.offset - 0.03).abs() < 1e-12, "{m:?}");
+        // an asymmetry that is not uniform stays in the shape and fails the check (< 3)
+        let mut tilted = values.clone();
+        tilted[0] += 0.05;
+        let m = mirror(&tilted, &errors, -1.0, true);
+        assert!(m.chi2 > 3.0, "{m:?}");
     }
 }

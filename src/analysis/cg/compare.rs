@@ -2,11 +2,12 @@
 //! the χ²/dof of the difference in units of the combined standard error (≈ 1: noise; ≫ 1:
 //! bias, or errors that miss slow fluctuations) and the difference of the core means relative
 //! to the reference's mean magnitude (how large a systematic difference is; the slices' noise
-//! averages down in it).
+//! averages down in it). For vx also the χ²/dof with the common offset removed and that offset:
+//! the bed's slow drift shifts the velocity profile as a whole (docs/statistics.md).
 
 use std::fmt::Write;
 
-use super::table::{chi2, Table};
+use super::table::{chi2, shape, Shape, Table};
 use super::{core_window, FIELDS};
 
 /// One table against the reference.
@@ -17,6 +18,8 @@ pub struct Comparison {
     pub chi2: [f64; 5],
     /// Σ(a − ref) / Σ|ref| of each profile over the core slices (dimensionless, signed).
     pub rel_mean: [f64; 5],
+    /// vx against the reference less their common offset ([`shape`]).
+    pub vx_shape: Shape,
 }
 
 /// Σ(a − b) / Σ|b| of column `col` over the grid points with z in `window`: the difference of
@@ -47,6 +50,7 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
                 name: name.clone(),
                 chi2: [0.0; 5],
                 rel_mean: [0.0; 5],
+                vx_shape: shape(t, reference, FIELDS[0].1, window)?,
             };
             for (f, &(_, col)) in FIELDS.iter().enumerate() {
                 c.chi2[f] = chi2(t, reference, col, window)?;
@@ -62,8 +66,9 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     let names: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
     let mut s = format!(
         "Against `{reference}`, core slices: χ²/dof (1 = noise) | difference of the core means \
-         relative to the reference's\n\n\
-         | profiles | {} | {} |\n|---|{}\n",
+         relative to the reference's | vx less the common offset of the two profiles: χ²/dof, and \
+         that offset\n\n\
+         | profiles | {} | {} | χ² vx less offset | vx offset |\n|---|{}\n",
         names
             .iter()
             .map(|n| format!("χ² {n}"))
@@ -74,12 +79,12 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
             .map(|n| format!("Δ {n}"))
             .collect::<Vec<_>>()
             .join(" | "),
-        "---|".repeat(2 * names.len())
+        "---|".repeat(2 * names.len() + 2)
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} |",
+            "| {} | {} | {} | {:.2} | {:+.2e} |",
             r.name,
             r.chi2
                 .iter()
@@ -90,7 +95,9 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
                 .iter()
                 .map(|c| format!("{:+.2} %", 100.0 * c))
                 .collect::<Vec<_>>()
-                .join(" | ")
+                .join(" | "),
+            r.vx_shape.chi2,
+            r.vx_shape.offset
         );
     }
     s
@@ -120,8 +127,12 @@ mod tests {
             assert!((rows[0].chi2[f] - 1.0).abs() < 1e-9, "{:?}", rows[0]);
             assert!((rows[0].rel_mean[f] - 0.03 * 2f64.sqrt() / 2.0).abs() < 1e-12);
         }
+        // the shift is the common offset: nothing is left in vx's shape
+        assert!(rows[0].vx_shape.chi2.abs() < 1e-12, "{:?}", rows[0]);
+        assert!((rows[0].vx_shape.offset - 0.03 * 2f64.sqrt()).abs() < 1e-12);
         let md = markdown("ref", &rows);
         assert!(md.contains("| shifted | 1.00 |"), "{md}");
+        assert!(md.contains("| 0.00 | +4.24e-2 |"), "{md}");
     }
 
     #[test]

@@ -129,22 +129,63 @@ fn field_name(col: usize) -> String {
 /// of (a − b)²/(se_a² + se_b²), ≈ 1 when they differ by noise only. Both tables must have the
 /// same grid.
 pub fn chi2(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Result<f64> {
+    Ok(mean_chi2(differences(a, b, col, window)?))
+}
+
+/// How two profiles differ apart from a uniform shift ([`shape`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shape {
+    /// χ²/dof of the difference less `offset` (one degree of freedom fewer than the points).
+    pub chi2: f64,
+    /// The common offset a − b: the mean difference weighted by 1/(se_a² + se_b²).
+    pub offset: f64,
+    /// Its standard error from the points' errors, (Σ 1/(se_a² + se_b²))^(−1/2), which takes
+    /// the points as independent (neighbouring slices are not: it is a lower bound).
+    pub offset_se: f64,
+}
+
+/// [`chi2`] after removing the common offset of the two profiles, and that offset: the shape
+/// test for a profile whose level drifts as a whole, as vx does with the bed's slow drift
+/// (docs/statistics.md). NaN χ² for fewer than two points with an error.
+pub fn shape(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Result<Shape> {
+    let pairs: Vec<(f64, f64)> = differences(a, b, col, window)?
+        .filter(|&(_, var)| var > 0.0)
+        .collect();
+    let weight: f64 = pairs.iter().map(|&(_, var)| 1.0 / var).sum();
+    let offset = pairs.iter().map(|&(d, var)| d / var).sum::<f64>() / weight;
+    let chi2: f64 = pairs
+        .iter()
+        .map(|&(d, var)| (d - offset).powi(2) / var)
+        .sum();
+    Ok(Shape {
+        chi2: chi2 / (pairs.len() as f64 - 1.0),
+        offset,
+        offset_se: weight.sqrt().recip(),
+    })
+}
+
+/// (a − b, se_a² + se_b²) of column `col` at the grid points with z in `window`; an error when
+/// the tables' grids differ.
+fn differences<'t>(
+    a: &'t Table,
+    b: &'t Table,
+    col: usize,
+    window: (f64, f64),
+) -> anyhow::Result<impl Iterator<Item = (f64, f64)> + 't> {
     anyhow::ensure!(
         a.z.len() == b.z.len() && a.z.iter().zip(&b.z).all(|(x, y)| (x - y).abs() < 1e-9),
         "the profiles are on different grids ({} and {} points)",
         a.z.len(),
         b.z.len()
     );
-    Ok(mean_chi2(
-        (0..a.z.len())
-            .filter(|&k| !(a.z[k] < window.0 || a.z[k] > window.1))
-            .map(|k| {
-                (
-                    a.mean[k][col] - b.mean[k][col],
-                    a.se[k][col].powi(2) + b.se[k][col].powi(2),
-                )
-            }),
-    ))
+    Ok((0..a.z.len())
+        .filter(move |&k| !(a.z[k] < window.0 || a.z[k] > window.1))
+        .map(move |k| {
+            (
+                a.mean[k][col] - b.mean[k][col],
+                a.se[k][col].powi(2) + b.se[k][col].powi(2),
+            )
+        }))
 }
 
 #[cfg(test)]
@@ -174,6 +215,25 @@ mod tests {
         // a shift of one combined standard error (√0.5) gives χ²/dof = 1 on every point
         let one = chi2(&back, &table(0.5f64.sqrt()), 3, (2.0, 8.0)).unwrap();
         assert!((one - 1.0).abs() < 1e-12, "{one}");
+    }
+
+    #[test]
+    fn the_shape_test_removes_a_uniform_shift_but_not_a_tilt() {
+        // a uniform shift of 3 combined errors: χ² 9 per point, none left in the shape
+        let shifted = table(3.0 * 0.5f64.sqrt());
+        let s = shape(&shifted, &table(0.0), 3, (0.0, 10.0)).unwrap();
+        assert!(s.chi2.abs() < 1e-20, "{s:?}");
+        assert!((s.offset - 3.0 * 0.5f64.sqrt()).abs() < 1e-12, "{s:?}");
+        // ten points of variance 0.5: the offset's error is √(0.5/10)
+        assert!((s.offset_se - 0.05f64.sqrt()).abs() < 1e-12, "{s:?}");
+        // a tilt of ±1 combined error about the middle stays in the shape: χ² over 9 dof
+        let mut tilted = table(0.0);
+        for (k, row) in tilted.mean.iter_mut().enumerate() {
+            row[3] += if k < 5 { -1.0 } else { 1.0 } * 0.5f64.sqrt();
+        }
+        let s = shape(&tilted, &table(0.0), 3, (0.0, 10.0)).unwrap();
+        assert!((s.chi2 - 10.0 / 9.0).abs() < 1e-12, "{s:?}");
+        assert!(s.offset.abs() < 1e-12, "{s:?}");
     }
 
     #[test]
