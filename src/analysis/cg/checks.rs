@@ -74,7 +74,8 @@ struct Mirror {
 /// A profile against its mirror image about the mid-plane (`sign` −1 for an antisymmetric one)
 /// over the pairs of slices k and n − 1 − k, with the pairs left out; with `less_offset`, the
 /// uniform offset of the profile is fitted (weighted by the pairs' errors) and removed first,
-/// one degree of freedom fewer. A slice whose error is not zero but below round-off of its value
+/// one degree of freedom fewer (pairs without an error, such as two empty slices, keep their
+/// difference as it is). A slice whose error is not zero but below round-off of its value
 /// (blocks that differ only in their last bits: a slice the particles barely reach) has no
 /// measured error; its pair is left out and counted rather than divided by a round-off error.
 /// An error of exactly zero (identical blocks) keeps its meaning: any difference from the
@@ -105,9 +106,8 @@ fn mirror(values: &[f64], errors: &[f64], sign: f64, less_offset: bool) -> Mirro
     let sum: f64 = pairs
         .iter()
         .map(|&(d, var)| {
-            let d = d - shift;
             if var > 0.0 {
-                d * d / var
+                (d - shift).powi(2) / var
             } else if d == 0.0 {
                 0.0
             } else {
@@ -542,6 +542,15 @@ mod tests {
         let m = mirror(&values, &errors, -1.0, true);
         assert!(m.chi2 < 1e-20, "{m:?}");
         assert!((m.offset - 0.03).abs() < 1e-12, "{m:?}");
+        // empty slices at both ends (value and error 0) take no offset
+        let mut padded = vec![0.0];
+        padded.extend(&values);
+        padded.push(0.0);
+        let mut padded_errors = vec![0.0];
+        padded_errors.extend(errors);
+        padded_errors.push(0.0);
+        let m = mirror(&padded, &padded_errors, -1.0, true);
+        assert!(m.chi2 < 1e-20, "{m:?}");
         // an asymmetry that is not uniform stays in the shape and fails the check (< 3)
         let mut tilted = values.clone();
         tilted[0] += 0.05;
