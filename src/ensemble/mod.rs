@@ -804,4 +804,22 @@ mod tests {
         perturb(&mut other, 1e-6, replica_seed(1, 4)).unwrap();
         assert_ne!(other.v, p.v);
     }
+
+    #[test]
+    fn a_zero_perturbation_leaves_every_velocity_bit_for_bit() {
+        let mut p = Particles::default();
+        // one free particle (too few for a perturbation) moving at -0 along x: adding a zero
+        // perturbation would turn -0 into +0
+        p.push(
+            Vec3::zeros(),
+            Vec3::new(-0.0, 1.0, 0.0),
+            Vec3::zeros(),
+            0.5,
+            1.0,
+            Motion::Free,
+        );
+        perturb(&mut p, 0.0, replica_seed(1, 0)).unwrap();
+        assert!(p.v[0].x.is_sign_negative(), "{:?}", p.v[0]);
+        assert!(perturb(&mut p, 1e-6, replica_seed(1, 0)).is_err());
+    }
 }
