@@ -460,17 +460,25 @@ impl Plan {
         let file = self.start_file(case, k);
         let sha = file.as_deref().map(file_sha256).transpose()?;
         if r.start_sha256 != sha {
-            let named = |f: Option<String>, sha: &Option<String>| match (f, sha) {
+            let named = |f: Option<String>, sha: &Option<String>, none: &str| match (f, sha) {
                 (Some(f), Some(sha)) => format!("{f} (SHA-256 {sha})"),
-                _ => "the case's generated scene".to_string(),
+                _ => none.to_string(),
             };
             bail!(
                 "{}: replica {k} started from {}, this ensemble's replica {k} starts from {}: the \
                  folder holds another ensemble's replica (give the --starts or --init it was \
                  run with)",
                 path.display(),
-                named(r.start_file.clone(), &r.start_sha256),
-                named(file.map(|f| f.display().to_string()), &sha)
+                named(
+                    r.start_file.clone(),
+                    &r.start_sha256,
+                    "no recorded file (a generated scene)"
+                ),
+                named(
+                    file.map(|f| f.display().to_string()),
+                    &sha,
+                    "the case's generated scene"
+                )
             );
         }
         Ok(())
