@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use common::{root, verdem_ok};
+use verdem::io::mercury::{read_data, DataFile};
 
 const CASE: &str = "cases/shear_flow_steady.toml";
 
@@ -139,6 +140,196 @@ fn local_replicas_are_perturbed_reproducible_and_merged() {
     assert_eq!(merged(&a), csv);
 }
 
+/// Two states of the steady case's geometry that differ: a save of MercuryDPM's reference run
+/// (time 143.85) and verdem's state after the full run (the case's own `run.init`).
+const STARTS: [&str; 2] = [
+    "data/states/mercury_t143.85.data",
+    "golden/full_run/shear_flow.final.data",
+];
+
+/// Runs a 2-replica ensemble of 1000 steps (a save every 500) of the steady case from
+/// [`STARTS`] into `out` on `engine`, with `extra` options.
+fn starts_ensemble(out: &Path, engine: &str, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "ensemble", CASE, "--starts", STARTS[0], STARTS[1], "--steps", "1000", "--every", "500",
+        "--engine", engine, "--poll", "0.5", "--out",
+    ];
+    args.push(out.to_str().unwrap());
+    args.extend(extra);
+    verdem_ok(&args)
+}
+
+/// The wall spheres of the steady case (2 walls × 12 rows × 20), the first lines of a state.
+const WALL_SPHERES: usize = 480;
+
+/// Replica `k`'s first save in the ensemble folder `out` and its start file `start`, which
+/// have the same time and number of particles.
+fn first_save_and_start(out: &Path, k: u64, start: &str) -> (DataFile, DataFile) {
+    let first = read_data(&out.join(format!("replica_{k}/shear_flow_steady.data.0000"))).unwrap();
+    let want = read_data(&root().join(start)).unwrap();
+    assert_eq!(first.time, want.time, "replica {k}");
+    assert_eq!(first.rows.len(), want.rows.len(), "replica {k}");
+    (first, want)
+}
+
+/// Hex SHA-256 of a file.
+fn sha256(path: &Path) -> String {
+    use sha2::{Digest, Sha256};
+    let bytes = std::fs::read(path).unwrap();
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// The state hash of the steady case from `init` after `steps` steps (`verdem hash`).
+fn hash_from(init: &str, steps: u64) -> String {
+    let out = verdem_ok(["hash", CASE, "--init", init, "--steps", &steps.to_string()]);
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
+
+/// Whether an ensemble command fails with a message that contains `needle`; `out` must then
+/// not have been created (nothing ran).
+fn refused(args: &[&str], out: &Path, needle: &str) {
+    let o = verdem(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{args:?} succeeded");
+    assert!(err.contains(needle), "no {needle:?} in {err}");
+    assert!(!out.exists(), "{args:?} wrote {}", out.display());
+}
+
+#[test]
+fn replicas_start_from_their_own_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a");
+    starts_ensemble(&a, "local", &[]);
+    for (k, start) in STARTS.iter().enumerate() {
+        let k = k as u64;
+        let file = root().join(start);
+        // the record names the start file and its content
+        assert_eq!(
+            record_field(&a, k, "start_file"),
+            file.display().to_string()
+        );
+        assert_eq!(record_field(&a, k, "start_sha256"), sha256(&file));
+        // the first save is the start: its time and every particle's position; the free
+        // particles' velocities perturbed (by about 1e-6), the walls' as they were
+        let (first, want) = first_save_and_start(&a, k, start);
+        for (a, (r, w)) in first.rows.iter().zip(&want.rows).enumerate() {
+            assert_eq!(r.x, w.x, "replica {k}, line {}", r.line);
+            if a < WALL_SPHERES {
+                assert_eq!(r.v, w.v, "replica {k}, wall sphere at line {}", r.line);
+            } else {
+                let dv = (r.v - w.v).norm();
+                assert!(dv > 0.0 && dv < 1e-4, "replica {k}, line {}: {dv}", r.line);
+            }
+        }
+    }
+    // merged again with the same starts: the same table; with other starts: refused
+    let csv = merged(&a);
+    let merge = |first: &str, second: &str| {
+        verdem(&[
+            "ensemble",
+            CASE,
+            "--starts",
+            first,
+            second,
+            "--merge",
+            "--out",
+            a.to_str().unwrap(),
+        ])
+    };
+    let again = merge(STARTS[0], STARTS[1]);
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert_eq!(merged(&a), csv);
+    let swapped = merge(STARTS[1], STARTS[0]);
+    let err = String::from_utf8_lossy(&swapped.stderr);
+    assert!(!swapped.status.success(), "merged with swapped starts");
+    assert!(
+        err.contains("replica 0 started from ")
+            && err.contains(STARTS[0].rsplit('/').next().unwrap())
+            && err.contains("another ensemble's replica"),
+        "{err}"
+    );
+    // without a perturbation, replica K is exactly a plain run from its start file
+    let b = dir.path().join("b");
+    starts_ensemble(&b, "local", &["--perturbation", "0"]);
+    for (k, start) in STARTS.iter().enumerate() {
+        let k = k as u64;
+        let (first, want) = first_save_and_start(&b, k, start);
+        for (r, w) in first.rows.iter().zip(&want.rows) {
+            assert_eq!((r.x, r.v), (w.x, w.v), "replica {k}, line {}", r.line);
+        }
+        assert_eq!(record_field(&b, k, "hash"), hash_from(start, 1000));
+    }
+}
+
+#[test]
+fn bad_starts_are_refused_before_any_replica_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    refused(
+        &[
+            "ensemble",
+            CASE,
+            "--starts",
+            STARTS[0],
+            STARTS[1],
+            "--replicas",
+            "3",
+            "--out",
+            o,
+        ],
+        &out,
+        "--replicas 3 but --starts names 2 files",
+    );
+    refused(
+        &[
+            "ensemble", CASE, "--starts", STARTS[0], STARTS[1], "--init", STARTS[0], "--out", o,
+        ],
+        &out,
+        "--starts and --init",
+    );
+    let missing = dir.path().join("missing.data");
+    refused(
+        &[
+            "ensemble",
+            CASE,
+            "--starts",
+            STARTS[0],
+            missing.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &out,
+        &format!("{}: cannot read", missing.display()),
+    );
+    // a start that does not parse: its file, line and field
+    let bad = dir.path().join("bad.data");
+    let text = std::fs::read_to_string(root().join(STARTS[1])).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[5] = "1 2 x 0 0 0 0.5 0 0 0 0 0 0 0";
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    refused(
+        &[
+            "ensemble",
+            CASE,
+            "--starts",
+            STARTS[0],
+            bad.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &out,
+        &format!("{}:6: column 3 (rz)", bad.display()),
+    );
+}
+
 #[test]
 fn slurm_and_local_give_the_same_replicas_and_profiles() {
     if !slurm_enabled() {
@@ -171,6 +362,30 @@ fn slurm_and_local_give_the_same_replicas_and_profiles() {
         finals.push(record_field(&slurm, k, "hash"));
     }
     assert!(finals[0] != finals[1] && finals[1] != finals[2] && finals[0] != finals[2]);
+    assert_eq!(merged(&slurm), merged(&local));
+}
+
+#[test]
+fn slurm_replicas_start_from_their_own_files_as_local_ones() {
+    if !slurm_enabled() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let local = dir.path().join("local");
+    let slurm = dir.path().join("slurm");
+    starts_ensemble(&local, "local", &[]);
+    starts_ensemble(&slurm, "slurm", &[]);
+    let script = std::fs::read_to_string(slurm.join("shear_flow_steady.sbatch")).unwrap();
+    assert!(script.contains(" --starts "), "{script}");
+    for k in 0..2 {
+        for field in ["start_file", "start_sha256", "start_hash", "hash"] {
+            assert_eq!(
+                record_field(&slurm, k, field),
+                record_field(&local, k, field),
+                "replica {k}: {field}"
+            );
+        }
+    }
     assert_eq!(merged(&slurm), merged(&local));
 }
 

@@ -11,7 +11,7 @@ use anyhow::Context;
 use verdem::case::Case;
 use verdem::ensemble::{self, local, slurm, Plan, ReplicaCommand};
 
-use super::args::{count, named, positive};
+use super::args::{count, named, non_negative, positive};
 use super::Finished;
 
 /// Where the replicas run.
@@ -36,9 +36,9 @@ impl EngineChoice {
 pub struct Args {
     /// Case file (TOML).
     case: PathBuf,
-    /// Number of replicas (2 or more for error bars).
-    #[arg(long, value_parser = count::<u64>)]
-    replicas: u64,
+    /// Number of replicas (2 or more for error bars; default with --starts: one per file).
+    #[arg(long, value_parser = count::<u64>, required_unless_present = "starts")]
+    replicas: Option<u64>,
     /// Where the replicas run: `local` (child processes on this machine's cores, one thread
     /// each) or `slurm` (a job array submitted with sbatch).
     #[arg(long, default_value = "local", value_parser = named(&EngineChoice::ALL, EngineChoice::name))]
@@ -46,6 +46,10 @@ pub struct Args {
     /// Initial configuration (default: the case's `run.init`), perturbed for each replica.
     #[arg(long)]
     init: Option<PathBuf>,
+    /// Replica K starts from the K-th of these state files (MercuryCG `.data`, as --init reads),
+    /// e.g. saves of a long run spaced by many correlation times; perturbed as with --init.
+    #[arg(long, num_args = 1..)]
+    starts: Vec<PathBuf>,
     /// Each replica ends at this step (default: the case's `run.steps`).
     #[arg(long, value_parser = count::<u64>)]
     steps: Option<u64>,
@@ -60,8 +64,8 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// Root-mean-square speed of each replica's random velocity perturbation of the free
-    /// particles (velocity units).
-    #[arg(long, default_value_t = 1e-6, value_parser = positive)]
+    /// particles (velocity units; 0: none, e.g. with --starts).
+    #[arg(long, default_value_t = 1e-6, value_parser = non_negative)]
     perturbation: f64,
     /// Local engine: at most this many replicas at once (default: the CPUs this process may use).
     #[arg(long, value_parser = count::<usize>)]
@@ -91,28 +95,38 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}_ensemble", case.name)));
+    let replicas = a.replicas.unwrap_or(a.starts.len() as u64);
     let plan = Plan {
         case: absolute(&a.case)?,
         init: a.init.as_deref().map(absolute).transpose()?,
-        replicas: a.replicas,
+        starts: a
+            .starts
+            .iter()
+            .map(|p| absolute(p))
+            .collect::<anyhow::Result<_>>()?,
+        replicas,
         base_seed: a.seed.unwrap_or(case.run.seed),
         perturbation: a.perturbation,
         steps: a.steps,
         save_every: a.every,
         out: absolute(&out)?,
     };
+    plan.validate()?;
     if let Some(k) = a.replica {
         let r = plan.run_replica(k)?;
         println!(
-            "replica {k}: seed {}, start hash {}, step {}, state hash {}",
-            r.seed, r.start_hash, r.step, r.hash
+            "replica {k}: seed {}, start {}, start hash {}, step {}, state hash {}",
+            r.seed,
+            r.start_file.as_deref().unwrap_or("generated"),
+            r.start_hash,
+            r.step,
+            r.hash
         );
         return Ok(Finished::Done);
     }
-    if a.replicas < 2 {
+    if replicas < 2 {
         anyhow::bail!(
-            "--replicas {}: an ensemble needs 2 replicas or more for its error bars",
-            a.replicas
+            "--replicas {replicas}: an ensemble needs 2 replicas or more for its error bars"
         );
     }
     let engine = if a.merge {
@@ -127,12 +141,11 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
                     .jobs
                     .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
                 println!(
-                    "{} replicas of {} on {jobs} local processes, into {}",
-                    a.replicas,
+                    "{replicas} replicas of {} on {jobs} local processes, into {}",
                     case.name,
                     plan.out.display()
                 );
-                local::run(&cmd, a.replicas, jobs, &plan.out)?
+                local::run(&cmd, replicas, jobs, &plan.out)?
             }
             EngineChoice::Slurm => {
                 let o = slurm::Options {
@@ -140,7 +153,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
                     poll: Duration::from_secs_f64(a.poll),
                     stop: Some(stop_on_signal()?),
                 };
-                slurm::run(&cmd, a.replicas, &plan.out, &case.name, &o)?.1
+                slurm::run(&cmd, replicas, &plan.out, &case.name, &o)?.1
             }
         };
         if let Some(report) = ensemble::failures(&outcomes) {
@@ -151,8 +164,11 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let merged = plan.merge(&case.name, engine)?;
     for r in &merged.records {
         println!(
-            "replica {}: seed {}, state hash {}",
-            r.replica, r.seed, r.hash
+            "replica {}: seed {}, start {}, state hash {}",
+            r.replica,
+            r.seed,
+            r.start_file.as_deref().unwrap_or("generated"),
+            r.hash
         );
     }
     print!("{}", merged.report());
@@ -183,6 +199,10 @@ fn replica_command(plan: &Plan) -> anyhow::Result<ReplicaCommand> {
     ];
     if let Some(init) = &plan.init {
         args.extend(["--init".into(), init.display().to_string()]);
+    }
+    if !plan.starts.is_empty() {
+        args.push("--starts".into());
+        args.extend(plan.starts.iter().map(|p| p.display().to_string()));
     }
     if let Some(steps) = plan.steps {
         args.extend(["--steps".into(), steps.to_string()]);

@@ -2,9 +2,11 @@
 //! ([`local`]) or as a Slurm job array ([`slurm`]), then merged into profiles with ensemble
 //! error bars ([`crate::analysis::ensemble`]).
 //!
-//! Replica k starts from the case's initial state with every free particle's velocity
-//! perturbed by a tiny random amount drawn from its own seed ([`replica_seed`], [`perturb`]);
-//! the flow's chaos grows the perturbation until the replicas are independent. Both engines run
+//! Replica k starts from the case's initial state, or from its own state file (`starts[k]`,
+//! e.g. saves of a long run spaced by many correlation times, so that the replicas do not share
+//! the start's slow modes), with every free particle's velocity perturbed by a tiny random
+//! amount drawn from its own seed ([`replica_seed`], [`perturb`]); the flow's chaos grows the
+//! perturbation until the replicas are independent. Both engines run
 //! a replica the same way, as a `verdem ensemble CASE --replica k` process that calls
 //! [`run_replica`], so replica k gives the same state hash whichever engine ran it.
 //! Layout of an ensemble's folder `DIR`: `DIR/replica_K/` holds replica K's run (saves,
@@ -19,6 +21,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use serde::Deserialize;
+use sha2::{Digest, Sha256};
 
 use crate::analysis::cg::blocking;
 use crate::analysis::cg::table::Table;
@@ -37,12 +40,16 @@ use crate::state::Particles;
 #[derive(Clone, Debug)]
 pub struct Plan {
     pub case: PathBuf,
-    /// Initial state (default: the case's `run.init`, else its generated scene).
+    /// Initial state of every replica (default: the case's `run.init`, else its generated
+    /// scene); `None` when `starts` is given.
     pub init: Option<PathBuf>,
+    /// Replica k's own initial state, `starts[k]` (MercuryCG `.data` or official file, as
+    /// `init`); empty: every replica starts from `init`. Else one file per replica.
+    pub starts: Vec<PathBuf>,
     pub replicas: u64,
     /// Base seed of the replicas' seeds ([`replica_seed`]).
     pub base_seed: u64,
-    /// Root-mean-square speed of each replica's velocity perturbation (velocity units).
+    /// Root-mean-square speed of each replica's velocity perturbation (velocity units; 0: none).
     pub perturbation: f64,
     /// Each replica ends at this step (default: the case's `run.steps`).
     pub steps: Option<u64>,
@@ -65,8 +72,12 @@ pub fn replica_seed(base: u64, k: u64) -> u64 {
 /// [`scene::random_velocities`]`(free, amplitude, seed)`: uniform in a cube, zero mean and
 /// root-mean-square speed `amplitude` over the free particles (so equal masses keep their total
 /// momentum). Wall spheres keep their prescribed velocities; positions and spins are untouched.
-/// Fewer than two free particles cannot be given a zero-mean perturbation: an error.
+/// Fewer than two free particles cannot be given a zero-mean perturbation: an error. An
+/// `amplitude` of 0 leaves the particles untouched (the start as it is, bit for bit).
 pub fn perturb(particles: &mut Particles, amplitude: f64, seed: u64) -> anyhow::Result<()> {
+    if amplitude == 0.0 {
+        return Ok(());
+    }
     let free: Vec<usize> = (0..particles.len())
         .filter(|&a| particles.is_free(a))
         .collect();
@@ -117,6 +128,11 @@ pub struct Record {
     #[serde(deserialize_with = "u64_text")]
     pub base_seed: u64,
     pub perturbation: f64,
+    /// The file the replica started from (absent for a generated scene) and its SHA-256 (hex).
+    #[serde(default)]
+    pub start_file: Option<String>,
+    #[serde(default)]
+    pub start_sha256: Option<String>,
     /// State hash after the perturbation, before the first step.
     pub start_hash: String,
     /// State hash at the end of the run.
@@ -141,11 +157,12 @@ fn u64_text<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
 impl Record {
     fn toml(&self) -> String {
         format!(
-            "replica = {}\nseed = \"{}\"\nbase_seed = \"{}\"\nperturbation = {:e}\nstart_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}\nblocks = {}\ninrun_dof = {:?}\n",
+            "replica = {}\nseed = \"{}\"\nbase_seed = \"{}\"\nperturbation = {:e}\n{}start_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}\nblocks = {}\ninrun_dof = {:?}\n",
             self.replica,
             self.seed,
             self.base_seed,
             self.perturbation,
+            self.start_lines(),
             self.start_hash,
             self.hash,
             self.step,
@@ -153,6 +170,14 @@ impl Record {
             self.blocks,
             self.inrun_dof
         )
+    }
+
+    /// The `start_file` and `start_sha256` lines (TOML), none for a generated scene.
+    fn start_lines(&self) -> String {
+        match (&self.start_file, &self.start_sha256) {
+            (Some(file), Some(sha)) => format!("start_file = {file:?}\nstart_sha256 = {sha:?}\n"),
+            _ => String::new(),
+        }
     }
 
     fn read(path: &Path) -> anyhow::Result<Record> {
@@ -168,23 +193,84 @@ impl Plan {
         Ok(Case::load(&self.case)?.name)
     }
 
-    /// Builds replica 0's start (the case, its initial state, the perturbation), so that bad
-    /// input is reported once, before any replica is started or submitted.
+    /// Refuses a plan whose start files do not fit it: `starts` together with `init`, or a
+    /// number of start files other than the number of replicas.
+    pub fn validate(&self) -> anyhow::Result<()> {
+        if self.starts.is_empty() {
+            return Ok(());
+        }
+        if let Some(init) = &self.init {
+            bail!(
+                "--starts and --init {} together: with --starts each replica starts from its own \
+                 file; give one of the two",
+                init.display()
+            );
+        }
+        if self.starts.len() as u64 != self.replicas {
+            bail!(
+                "--replicas {} but --starts names {} files: replica K starts from the K-th file, \
+                 so give as many replicas as start files (or leave --replicas out)",
+                self.replicas,
+                self.starts.len()
+            );
+        }
+        Ok(())
+    }
+
+    /// The initial state file replica `k` starts from: `starts[k]`, else `init`, else the
+    /// case's `run.init`; `None` when it starts from the case's generated scene.
+    pub fn start_file(&self, case: &Case, k: u64) -> Option<PathBuf> {
+        if !from_file(case) {
+            return None;
+        }
+        self.starts
+            .get(k as usize)
+            .or(self.init.as_ref())
+            .cloned()
+            .or_else(|| case.run.init.as_deref().map(|p| case.resolve(p)))
+    }
+
+    /// Builds the start of replica 0, or of every replica when they start from their own
+    /// files (the case, the initial state, the perturbation), so that bad input is reported
+    /// once, before any replica is started or submitted.
     pub fn check(&self) -> anyhow::Result<()> {
+        self.validate()?;
         let case = Case::load(&self.case)?;
-        let mut start = scene::build(&case, self.init.as_deref())?;
-        perturb(
-            &mut start.particles,
-            self.perturbation,
-            replica_seed(self.base_seed, 0),
-        )
+        let checked = if self.starts.is_empty() {
+            1
+        } else {
+            self.replicas
+        };
+        for k in 0..checked {
+            self.start(&case, k)?;
+        }
+        Ok(())
+    }
+
+    /// Replica `k`'s start: its initial state ([`Plan::start_file`]) perturbed with
+    /// [`replica_seed`]`(base_seed, k)`, and that seed.
+    fn start(&self, case: &Case, k: u64) -> anyhow::Result<(scene::Scene, u64)> {
+        let init = self.starts.get(k as usize).or(self.init.as_ref());
+        if let Some(init) = init.filter(|_| !from_file(case)) {
+            bail!(
+                "{}: the case {} generates its scene, it cannot start from a file",
+                init.display(),
+                self.case.display()
+            );
+        }
+        let mut start = scene::build(case, init.map(PathBuf::as_path))?;
+        let seed = replica_seed(self.base_seed, k);
+        perturb(&mut start.particles, self.perturbation, seed)?;
+        Ok((start, seed))
     }
 
     /// Runs replica `k` on one thread into [`replica_dir`], replacing an earlier run of it
-    /// there: the case's initial state, perturbed with [`replica_seed`]`(base_seed, k)`, run to
-    /// the end step with saves, its summary, its coarse-grained profiles ([`cg::write_all`],
-    /// the case's defaults: the second half of the saves) and its [`Record`].
+    /// there: its initial state ([`Plan::start_file`]), perturbed with
+    /// [`replica_seed`]`(base_seed, k)`, run to the end step with saves, its summary, its
+    /// coarse-grained profiles ([`cg::write_all`], the case's defaults: the second half of the
+    /// saves) and its [`Record`].
     pub fn run_replica(&self, k: u64) -> anyhow::Result<Record> {
+        self.validate()?;
         if k >= self.replicas {
             bail!(
                 "replica {k} does not exist: the ensemble has {} (0 to {})",
@@ -193,9 +279,9 @@ impl Plan {
             );
         }
         let case = Case::load(&self.case)?;
-        let mut start = scene::build(&case, self.init.as_deref())?;
-        let seed = replica_seed(self.base_seed, k);
-        perturb(&mut start.particles, self.perturbation, seed)?;
+        let (start, seed) = self.start(&case, k)?;
+        let start_file = self.start_file(&case, k);
+        let start_sha256 = start_file.as_deref().map(file_sha256).transpose()?;
         let mut engine = engine::build(
             &case,
             start,
@@ -248,6 +334,8 @@ impl Plan {
             seed,
             base_seed: self.base_seed,
             perturbation: self.perturbation,
+            start_file: start_file.map(|p| p.display().to_string()),
+            start_sha256,
             start_hash,
             hash: s.hash,
             step: s.step,
@@ -311,6 +399,8 @@ impl Plan {
     /// summary `NAME.ensemble.toml`, and returns what they hold. Every replica must have
     /// finished with this plan's seeds and perturbation.
     pub fn merge(&self, name: &str, engine: &str) -> anyhow::Result<Merged> {
+        self.validate()?;
+        let case = Case::load(&self.case)?;
         let mut records = Vec::new();
         let mut tables = Vec::new();
         for k in 0..self.replicas {
@@ -324,6 +414,7 @@ impl Plan {
                 );
             }
             let r = Record::read(&path)?;
+            self.check_start(&case, k, &r, &path)?;
             let seed = replica_seed(self.base_seed, k);
             if r.replica != k || r.seed != seed || r.perturbation != self.perturbation {
                 bail!(
@@ -361,6 +452,53 @@ impl Plan {
         atomic::write(&summary_path(&self.out, name), merged.toml(self).as_bytes())?;
         Ok(merged)
     }
+
+    /// Refuses replica `k`'s record (read from `path`) when the replica started from another
+    /// file than this plan's (by content: SHA-256), or from a file when this plan's starts from
+    /// the generated scene, or the other way round.
+    fn check_start(&self, case: &Case, k: u64, r: &Record, path: &Path) -> anyhow::Result<()> {
+        let file = self.start_file(case, k);
+        let sha = file.as_deref().map(file_sha256).transpose()?;
+        if r.start_sha256 != sha {
+            let named = |f: Option<String>, sha: &Option<String>, none: &str| match (f, sha) {
+                (Some(f), Some(sha)) => format!("{f} (SHA-256 {sha})"),
+                _ => none.to_string(),
+            };
+            bail!(
+                "{}: replica {k} started from {}, this ensemble's replica {k} starts from {}: the \
+                 folder holds another ensemble's replica (give the --starts or --init it was \
+                 run with)",
+                path.display(),
+                named(
+                    r.start_file.clone(),
+                    &r.start_sha256,
+                    "no recorded file (a generated scene)"
+                ),
+                named(
+                    file.map(|f| f.display().to_string()),
+                    &sha,
+                    "the case's generated scene"
+                )
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Whether `case` starts from a file when given one (its scene is bumpy shear; the other
+/// scenes are generated).
+fn from_file(case: &Case) -> bool {
+    matches!(case.scene, crate::case::Scene::BumpyShear { .. })
+}
+
+/// Hex SHA-256 of the file at `path`.
+pub fn file_sha256(path: &Path) -> anyhow::Result<String> {
+    let mut f = std::fs::File::open(path)
+        .with_context(|| format!("{}: cannot read the start file", path.display()))?;
+    let mut h = Sha256::new();
+    std::io::copy(&mut f, &mut h)
+        .with_context(|| format!("{}: cannot read the start file", path.display()))?;
+    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// The in-run averaging of a replica of a bumpy-shear `case` (none for other scenes), as
@@ -460,7 +598,7 @@ pub struct Merged {
 }
 
 impl Merged {
-    /// The summary file's text (TOML): the plan, each replica's seed and hashes, and per
+    /// The summary file's text (TOML): the plan, each replica's seed, start file and hashes, and per
     /// benchmark profile its core mean with the ensemble error and the coverage test.
     pub fn toml(&self, plan: &Plan) -> String {
         let mut s = String::new();
@@ -472,8 +610,14 @@ impl Merged {
         for r in &self.records {
             let _ = writeln!(
                 s,
-                "\n[[replica]]\nreplica = {}\nseed = \"{}\"\nstart_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}",
-                r.replica, r.seed, r.start_hash, r.hash, r.step, r.saves
+                "\n[[replica]]\nreplica = {}\nseed = \"{}\"\n{}start_hash = {:?}\nhash = {:?}\nstep = {}\nsaves = {}",
+                r.replica,
+                r.seed,
+                r.start_lines(),
+                r.start_hash,
+                r.hash,
+                r.step,
+                r.saves
             );
         }
         let inrun = self.inrun.iter().flat_map(|(_, c)| c);
@@ -667,5 +811,23 @@ mod tests {
         let mut other = before;
         perturb(&mut other, 1e-6, replica_seed(1, 4)).unwrap();
         assert_ne!(other.v, p.v);
+    }
+
+    #[test]
+    fn a_zero_perturbation_leaves_every_velocity_bit_for_bit() {
+        let mut p = Particles::default();
+        // one free particle (too few for a perturbation) moving at -0 along x: adding a zero
+        // perturbation would turn -0 into +0
+        p.push(
+            Vec3::zeros(),
+            Vec3::new(-0.0, 1.0, 0.0),
+            Vec3::zeros(),
+            0.5,
+            1.0,
+            Motion::Free,
+        );
+        perturb(&mut p, 0.0, replica_seed(1, 0)).unwrap();
+        assert!(p.v[0].x.is_sign_negative(), "{:?}", p.v[0]);
+        assert!(perturb(&mut p, 1e-6, replica_seed(1, 0)).is_err());
     }
 }
