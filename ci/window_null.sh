@@ -12,7 +12,7 @@
 # (spread_ratio, 1 when honest), which calibrated cg::blocking::REFERENCE_TAU. Writes
 # golden/full_run_official/window_null.toml.
 #   RUN=DIR   the official full run's folder with all its saves (default out/official_full,
-#             made by ci/record_full_run.sh with --init data/GranularShearFlow.data)
+#             made by `OUT=out/official_full INIT=data/GranularShearFlow.data ci/record_full_run.sh`)
 #   JOBS=N    windows at once (default 2, one thread each)
 set -euo pipefail
 cd "$(dirname "$0")/.."
