@@ -348,13 +348,14 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
                     m.offset.abs(),
                     Limit::Below(tol),
                 )
+                .judged_if(judged)
                 .described(
                     format!(
                         "offset {:+.2e} (the bed's drift: standard deviation {BED_DRIFT_SD:.1e}, \
                          docs/statistics.md)",
                         Shown(m.offset)
                     ),
-                    format!("|offset| < {tol:.2e}"),
+                    format!("|offset| < {tol:.2e}{unjudged}"),
                 ),
             );
         }

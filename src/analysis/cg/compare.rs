@@ -61,6 +61,16 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
         .collect()
 }
 
+/// `text` when `value` is finite, else "undefined" (no error bar to take an offset with): no
+/// NaN is written.
+fn finite_or_undefined(text: String, value: f64) -> String {
+    if value.is_finite() {
+        text
+    } else {
+        "undefined".into()
+    }
+}
+
 /// The comparisons as a markdown table, one row per table.
 pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     let names: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
@@ -84,7 +94,7 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.2} | {:+.2e} |",
+            "| {} | {} | {} | {} | {} |",
             r.name,
             r.chi2
                 .iter()
@@ -96,8 +106,8 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
                 .map(|c| format!("{:+.2} %", 100.0 * c))
                 .collect::<Vec<_>>()
                 .join(" | "),
-            r.vx_shape.chi2,
-            r.vx_shape.offset
+            finite_or_undefined(format!("{:.2}", r.vx_shape.chi2), r.vx_shape.chi2),
+            finite_or_undefined(format!("{:+.2e}", r.vx_shape.offset), r.vx_shape.offset)
         );
     }
     s
@@ -145,5 +155,14 @@ mod tests {
         let rows = compare(&reference, &[("walls".into(), near_walls)]).unwrap();
         assert_eq!(rows[0].chi2, [0.0; 5]);
         assert_eq!(rows[0].rel_mean, [0.0; 5]);
+    }
+
+    #[test]
+    fn profiles_without_errors_give_no_offset_and_no_nan() {
+        let rows = compare(&flat(1.0, 0.0), &[("exact".into(), flat(1.5, 0.0))]).unwrap();
+        assert!(rows[0].vx_shape.offset.is_nan(), "{:?}", rows[0]);
+        let md = markdown("ref", &rows);
+        assert!(md.contains("| undefined | undefined |"), "{md}");
+        assert!(!md.contains("NaN"), "{md}");
     }
 }

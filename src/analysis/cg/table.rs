@@ -146,7 +146,7 @@ pub struct Shape {
 
 /// [`chi2`] after removing the common offset of the two profiles, and that offset: the shape
 /// test for a profile whose level drifts as a whole, as vx does with the bed's slow drift
-/// (docs/statistics.md). NaN χ² for fewer than two points with an error.
+/// (docs/statistics.md). NaN χ² for fewer than two points with an error, NaN offset for none.
 pub fn shape(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Result<Shape> {
     let pairs: Vec<(f64, f64)> = differences(a, b, col, window)?
         .filter(|&(_, var)| var > 0.0)
@@ -158,7 +158,11 @@ pub fn shape(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Re
         .map(|&(d, var)| (d - offset).powi(2) / var)
         .sum();
     Ok(Shape {
-        chi2: chi2 / (pairs.len() as f64 - 1.0),
+        chi2: if pairs.len() < 2 {
+            f64::NAN
+        } else {
+            chi2 / (pairs.len() as f64 - 1.0)
+        },
         offset,
         offset_se: weight.sqrt().recip(),
     })
