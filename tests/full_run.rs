@@ -4,7 +4,8 @@
 //! windows of the same length of the full run itself do (golden/full_run/window_chi2.toml, made
 //! by ci/window_chi2.sh: the block errors of a short series miss the flow's slow fluctuations,
 //! so χ²/dof of the same physics is well above 1). Averaged in-run, the same short run matches
-//! the second full run's in-run profiles (golden/full_run_official/) with plain statistics.
+//! the second full run's in-run profiles (golden/full_run_official/) as 39 same-physics windows
+//! do (golden/full_run_official/window_null.toml, made by ci/window_null.sh).
 //!
 //! The peers' long runs from that state (golden/peers/, made by ci/record_peers.sh: LAMMPS and
 //! LIGGGHTS, and verdem itself, 1e7 steps each) are judged with the same yardstick: the short
