@@ -9,7 +9,7 @@ use crate::analysis::{Limit, Verdict};
 
 /// A number in a report: as formatted when finite, else "undefined" (one block gives no error
 /// bar, an empty core no mean): no NaN or infinity is written.
-struct Shown(f64);
+pub(super) struct Shown(pub(super) f64);
 
 impl std::fmt::Display for Shown {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -92,14 +92,13 @@ fn mirror(values: &[f64], errors: &[f64], sign: f64, less_offset: bool) -> Mirro
             (d, errors[k].powi(2) + errors[n - 1 - k].powi(2))
         })
         .collect();
-    let weight: f64 = pairs.iter().filter(|p| p.1 > 0.0).map(|p| 1.0 / p.1).sum();
-    let shift = if less_offset && weight > 0.0 {
-        pairs
-            .iter()
-            .filter(|p| p.1 > 0.0)
-            .map(|p| p.0 / p.1)
-            .sum::<f64>()
-            / weight
+    let (d, se): (Vec<f64>, Vec<f64>) = pairs
+        .iter()
+        .filter(|p| p.1 > 0.0)
+        .map(|&(d, var)| (d, var.sqrt()))
+        .unzip();
+    let shift = if less_offset && !d.is_empty() {
+        weighted_mean_chi2(&d, &se).0
     } else {
         0.0
     };

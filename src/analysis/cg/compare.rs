@@ -7,6 +7,7 @@
 
 use std::fmt::Write;
 
+use super::checks::Shown;
 use super::table::{chi2, shape, Shape, Table};
 use super::{core_window, FIELDS};
 
@@ -61,16 +62,6 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
         .collect()
 }
 
-/// `text` when `value` is finite, else "undefined" (no error bar to take an offset with): no
-/// NaN is written.
-fn finite_or_undefined(text: String, value: f64) -> String {
-    if value.is_finite() {
-        text
-    } else {
-        "undefined".into()
-    }
-}
-
 /// The comparisons as a markdown table, one row per table.
 pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     let names: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
@@ -94,7 +85,7 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {:.2} | {:+.2e} |",
             r.name,
             r.chi2
                 .iter()
@@ -106,8 +97,8 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
                 .map(|c| format!("{:+.2} %", 100.0 * c))
                 .collect::<Vec<_>>()
                 .join(" | "),
-            finite_or_undefined(format!("{:.2}", r.vx_shape.chi2), r.vx_shape.chi2),
-            finite_or_undefined(format!("{:+.2e}", r.vx_shape.offset), r.vx_shape.offset)
+            Shown(r.vx_shape.chi2),
+            Shown(r.vx_shape.offset)
         );
     }
     s

@@ -1,7 +1,7 @@
 //! Profiles as a table of numbers: written as CSV, read back (golden peer profiles are stored
 //! this way), and compared slice by slice against their combined standard errors.
 
-use crate::analysis::stats::mean_chi2;
+use crate::analysis::stats::{mean_chi2, weighted_mean_chi2};
 use crate::io::{csv_table, read_text, FormatError};
 
 use super::{columns, Grid, Profiles, COLUMNS};
@@ -148,23 +148,15 @@ pub struct Shape {
 /// test for a profile whose level drifts as a whole, as vx does with the bed's slow drift
 /// (docs/statistics.md). NaN χ² for fewer than two points with an error, NaN offset for none.
 pub fn shape(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> anyhow::Result<Shape> {
-    let pairs: Vec<(f64, f64)> = differences(a, b, col, window)?
+    let (d, se): (Vec<f64>, Vec<f64>) = differences(a, b, col, window)?
         .filter(|&(_, var)| var > 0.0)
-        .collect();
-    let weight: f64 = pairs.iter().map(|&(_, var)| 1.0 / var).sum();
-    let offset = pairs.iter().map(|&(d, var)| d / var).sum::<f64>() / weight;
-    let chi2: f64 = pairs
-        .iter()
-        .map(|&(d, var)| (d - offset).powi(2) / var)
-        .sum();
+        .map(|(d, var)| (d, var.sqrt()))
+        .unzip();
+    let (offset, chi2) = weighted_mean_chi2(&d, &se);
     Ok(Shape {
-        chi2: if pairs.len() < 2 {
-            f64::NAN
-        } else {
-            chi2 / (pairs.len() as f64 - 1.0)
-        },
+        chi2: if d.len() < 2 { f64::NAN } else { chi2 },
         offset,
-        offset_se: weight.sqrt().recip(),
+        offset_se: se.iter().map(|s| s.powi(-2)).sum::<f64>().sqrt().recip(),
     })
 }
 
