@@ -84,8 +84,8 @@ fn errors_with_the_reference_tau_cover_a_slow_mode_and_with_their_own_tau_do_not
     let nu = COLUMNS.iter().position(|c| *c == "nu").unwrap();
     let field = FIELDS.iter().position(|f| f.0 == "nu").unwrap();
     let tau = 0.5 * (tau_of(SLOW) + tau_of(FAST));
-    let mut floor = vec![0.0; COLUMNS.len()];
-    floor[nu] = tau;
+    let mut floor = blocking::Floor::none();
+    floor.slice[nu] = tau;
     let mut rng = rand_pcg::Pcg64::seed_from_u64(24);
     let (mut with, mut without) = (Vec::new(), Vec::new());
     let mut dof = f64::INFINITY;
@@ -131,5 +131,90 @@ fn errors_with_the_reference_tau_cover_a_slow_mode_and_with_their_own_tau_do_not
         "own tau: coverage {}, spread/SE {}",
         own.fraction(),
         own.spread_ratio
+    );
+}
+
+/// One replica's units in which every slice's volume fraction is 0.4 plus a slow series common
+/// to all slices (variance 1e-4) and a fast one of its own (variance 1e-3): each slice's τ is
+/// mostly the fast one's, its core mean's the slow one's.
+fn coherent_replica(grid: &Grid, rng: &mut rand_pcg::Pcg64) -> Vec<Unit> {
+    let slow = ar1(SLOW, UNITS, 1e-4, rng);
+    let fast: Vec<Vec<f64>> = (0..grid.n).map(|_| ar1(FAST, UNITS, 1e-3, rng)).collect();
+    (0..UNITS)
+        .map(|t| {
+            let mut raw = Raw::zeros(grid.n);
+            for k in 0..grid.n {
+                raw.nu[k] = 0.4 + slow[t] + fast[k][t];
+                raw.rho[k] = 1.0;
+            }
+            Unit::of_save(raw)
+        })
+        .collect()
+}
+
+/// Replicas of the core-mean test.
+const CORE_REPLICAS: usize = 120;
+
+#[test]
+fn a_core_mean_takes_the_cores_reference_tau_and_its_errors_then_cover_a_coherent_mode() {
+    let grid = Grid {
+        z0: 0.0,
+        z1: 22.0,
+        n: 100,
+    };
+    let nu = COLUMNS.iter().position(|c| *c == "nu").unwrap();
+    // the slices' τ, variance-weighted: (1e-4·τ_slow + 1e-3·τ_fast) / 1.1e-3 ≈ 4.4; the core
+    // mean's: the fast parts average out over ~73 slices, (1e-4·τ_slow + 1.4e-5·τ_fast) /
+    // 1.14e-4 ≈ 29 (300 units: ~10 τ, an error from τ with ~9 degrees of freedom)
+    let slice_tau = (1e-4 * tau_of(SLOW) + 1e-3 * tau_of(FAST)) / 1.1e-3;
+    let core_tau = (1e-4 * tau_of(SLOW) + 1e-3 / 73.0 * tau_of(FAST)) / (1e-4 + 1e-3 / 73.0);
+    let slice_only = {
+        let mut f = blocking::Floor::none();
+        f.slice[nu] = slice_tau;
+        f.core[nu] = slice_tau;
+        f
+    };
+    let with_core = {
+        let mut f = slice_only.clone();
+        f.core[nu] = core_tau;
+        f
+    };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(27);
+    // per floor: the mean over the replicas of t², t = (core mean − 0.4) / its error
+    let (mut honest, mut short) = (0.0, 0.0);
+    let mut dof = f64::INFINITY;
+    for _ in 0..CORE_REPLICAS {
+        let units = coherent_replica(&grid, &mut rng);
+        for (floor, sum) in [(&with_core, &mut honest), (&slice_only, &mut short)] {
+            let e = blocking::field_errors_with_floor(&units, &grid, floor);
+            let c = blocking::core_mean(&units, &grid, &e, nu);
+            *sum += ((c.mean - 0.4) / c.se).powi(2) / CORE_REPLICAS as f64;
+            if std::ptr::eq(floor, &with_core) {
+                assert!(
+                    c.long_enough,
+                    "an error from the core's τ over ≥ 5 τ is trusted"
+                );
+                dof = dof.min(c.dof);
+            }
+        }
+    }
+    // Student's t with ν degrees of freedom has E[t²] = ν/(ν − 2), and the mean of 120 values
+    // scatters by √(Var t² / 120) (≈ 0.2 at ν = 9); with the core's τ the mean lies within
+    // three of those of its expectation (of the replicas' fewest degrees of freedom, and of
+    // infinitely many); with the slices' τ the errors are ~2.6 times too small and t² is
+    // several times larger
+    let mean_t2 = |v: f64| v / (v - 2.0);
+    let sd = |v: f64| {
+        let m4 = 3.0 * v * v / ((v - 2.0) * (v - 4.0));
+        ((m4 - mean_t2(v).powi(2)) / CORE_REPLICAS as f64).sqrt()
+    };
+    assert!(dof > 5.0, "{dof}");
+    assert!(
+        (1.0 - 3.0 * sd(dof)..=mean_t2(dof) + 3.0 * sd(dof)).contains(&honest),
+        "with the core's τ: mean t² {honest} ({dof} degrees of freedom)"
+    );
+    assert!(
+        short > 2.0 * honest && short > mean_t2(dof) + 3.0 * sd(dof),
+        "with the slices' τ: mean t² {short} against {honest}"
     );
 }

@@ -121,7 +121,7 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
         let n = lines.len();
         std::fs::write(&walls_txt, lines[..n - 1].join("\n") + "\n").unwrap();
         let profiles = |o: &CgOptions| {
-            peers::inrun::peer_profiles(peer, &peer_dir, o, &template, sampling)
+            peers::inrun::peer_profiles(peer, &peer_dir, o, &template, sampling, case.dt())
                 .map(|_| ())
                 .unwrap_err()
                 .to_string()

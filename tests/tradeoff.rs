@@ -7,12 +7,12 @@ use verdem::analysis::difference::{CoreMean, Difference};
 use verdem::analysis::tradeoff::{self, call, Bias, Call, Outcome, Plan, CONTROL, REFERENCE};
 
 /// A bias of a variant (mean `delta` above a reference at 1.0) with both core means' standard
-/// error `se` from 20 blocks, relative to 1.0.
+/// error `se` with 19 degrees of freedom, relative to 1.0.
 fn bias(field: &'static str, delta: f64, se: f64, trusted: bool) -> Bias {
     let m = |mean| CoreMean {
         mean,
         se,
-        blocks: 20,
+        dof: 19.0,
         long_enough: trusted,
     };
     Bias {
@@ -95,25 +95,25 @@ fn a_five_sigma_bias_costs_and_a_wide_zero_bias_is_undecided() {
 
 #[test]
 fn replicas_merge_into_their_mean_with_the_ensembles_error() {
-    let c = |mean, se, blocks, long_enough| CoreMean {
+    let c = |mean, se, dof, long_enough| CoreMean {
         mean,
         se,
-        blocks,
+        dof,
         long_enough,
     };
     // one replica is its own
-    let one = c(1.0, 0.03, 10, false);
+    let one = c(1.0, 0.03, 9.0, false);
     assert_eq!(tradeoff::merge_core(&[one]), one);
-    // three: their mean; the spread of 1, 2, 3 (sd 1) over √3; 2 degrees of freedom (3
-    // blocks); trusted although one replica's blocks were too short
+    // three: their mean; the spread of 1, 2, 3 (sd 1) over √3; 2 degrees of freedom; trusted
+    // although one replica's errors were not
     let m = tradeoff::merge_core(&[
-        c(1.0, 0.03, 10, true),
-        c(2.0, 0.04, 6, false),
-        c(3.0, 0.01, 8, true),
+        c(1.0, 0.03, 9.0, true),
+        c(2.0, 0.04, 5.0, false),
+        c(3.0, 0.01, 7.0, true),
     ]);
     assert!((m.mean - 2.0).abs() < 1e-15);
     assert!((m.se - 1.0 / 3f64.sqrt()).abs() < 1e-15, "{}", m.se);
-    assert_eq!(m.blocks, 3);
+    assert_eq!(m.dof, 2.0);
     assert!(m.long_enough);
 }
 
@@ -122,7 +122,7 @@ fn each_replica_has_its_own_row_of_core_means() {
     let c = |mean| CoreMean {
         mean,
         se: 0.5,
-        blocks: 7,
+        dof: 6.5,
         long_enough: true,
     };
     let path = common::root().join("golden/tradeoff/tradeoff.csv");
@@ -134,9 +134,9 @@ fn each_replica_has_its_own_row_of_core_means() {
     let text = tradeoff::replicas_csv(&out);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 4, "{text}");
-    assert!(lines[0].starts_with("variant,replica,vx_mean,vx_se,vx_blocks,vx_trusted,nu_mean"));
+    assert!(lines[0].starts_with("variant,replica,vx_mean,vx_se,vx_dof,vx_trusted,nu_mean"));
     assert!(
-        lines[1].starts_with("reference,0,1e0,5e-1,7,true,1e0"),
+        lines[1].starts_with("reference,0,1e0,5e-1,6.5,true,1e0"),
         "{}",
         lines[1]
     );

@@ -286,6 +286,7 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
         &verdem::analysis::cg::CgOptions::for_case(&case),
         &template,
         peers::inrun::sampling(4800, k, kp),
+        case.dt(),
     )
     .map(|_| ())
     .unwrap_err()

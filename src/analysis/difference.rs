@@ -1,40 +1,21 @@
 //! Two in-run results compared by their core means: each mean with its standard error from
-//! the field's own blocks ([`CoreMean`]), and the difference A − B with its 95 % interval
+//! the series of its core mean ([`CoreMean`]), and the difference A − B with its 95 % interval
 //! (Student's t, Welch's degrees of freedom; [`Difference`]). Used by the cross-code comparison
 //! (`verdem cross … --inrun`) and the speed/accuracy trade (`verdem tradeoff`).
 
 use crate::analysis::cg::{self, COLUMNS, FIELDS};
 use crate::analysis::ensemble::student_t_within;
-use crate::analysis::inrun::{core_mean, InrunResult};
+use crate::analysis::inrun::InrunResult;
 use crate::analysis::stats::{block_standard_error, blocks_for, integrated_autocorrelation};
 
-/// The core mean of one profile of an in-run result: the mean over the core slices, its
-/// standard error from the field's own blocks, their number, and whether those blocks are as
-/// long as its correlation asks ([`cg::blocking::field_errors`]; if not, the error is too
-/// small).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CoreMean {
-    pub mean: f64,
-    pub se: f64,
-    pub blocks: usize,
-    pub long_enough: bool,
-}
+pub use crate::analysis::cg::blocking::CoreMean;
 
 impl CoreMean {
-    /// Of column `name` of [`COLUMNS`] in `r`.
+    /// Of column `name` of [`COLUMNS`] in `r`: the mean over the core slices and its standard
+    /// error from the series of the core mean ([`cg::blocking::core_mean`]).
     pub fn of(r: &InrunResult, name: &str) -> CoreMean {
         let c = COLUMNS.iter().position(|x| *x == name).expect("column");
-        let blocks = r.errors.blocks[c];
-        let (mean, se) = core_mean(&r.units, &r.profiles.grid, blocks, name);
-        CoreMean {
-            mean,
-            se,
-            blocks,
-            long_enough: matches!(
-                r.errors.method[c],
-                crate::analysis::cg::blocking::Method::Blocks
-            ),
-        }
+        cg::blocking::core_mean(&r.units, &r.profiles.grid, &r.errors, c)
     }
 }
 
@@ -53,7 +34,7 @@ pub fn wall_shear(r: &InrunResult, g: usize) -> CoreMean {
     CoreMean {
         mean: x.iter().sum::<f64>() / x.len().max(1) as f64,
         se: block_standard_error(&x, blocks),
-        blocks,
+        dof: blocks as f64 - 1.0,
         long_enough,
     }
 }
@@ -81,13 +62,11 @@ impl Difference {
     }
 
     /// The degrees of freedom of [`Difference::se`] (Welch 1947, Satterthwaite 1946):
-    /// (s_A² + s_B²)² / (s_A⁴/(n_A − 1) + s_B⁴/(n_B − 1)), n the blocks of each.
+    /// (s_A² + s_B²)² / (s_A⁴/ν_A + s_B⁴/ν_B), ν the degrees of freedom of each error (at
+    /// least 1).
     pub fn dof(&self) -> f64 {
         let (va, vb) = (self.a.se.powi(2), self.b.se.powi(2));
-        let (na, nb) = (
-            self.a.blocks.max(2) as f64 - 1.0,
-            self.b.blocks.max(2) as f64 - 1.0,
-        );
+        let (na, nb) = (self.a.dof.max(1.0), self.b.dof.max(1.0));
         let den = va * va / na + vb * vb / nb;
         if den > 0.0 {
             (va + vb).powi(2) / den
@@ -107,7 +86,7 @@ impl Difference {
         self.delta().abs() > self.half_width()
     }
 
-    /// Whether both errors come from blocks as long as the field's correlation asks.
+    /// Whether both errors can be trusted ([`CoreMean::long_enough`]).
     pub fn errors_trusted(&self) -> bool {
         self.a.long_enough && self.b.long_enough
     }
@@ -158,10 +137,10 @@ impl Difference {
     /// The difference of two core means of the pressure, each `(mean, se, blocks)` from
     /// blocks as long as its correlation asks (χ²/dof 1): for the tests of what reads it.
     pub(crate) fn of_pressure_means(a: (f64, f64, usize), b: (f64, f64, usize)) -> Difference {
-        let m = |(mean, se, blocks)| CoreMean {
+        let m = |(mean, se, blocks): (f64, f64, usize)| CoreMean {
             mean,
             se,
-            blocks,
+            dof: blocks as f64 - 1.0,
             long_enough: true,
         };
         Difference {

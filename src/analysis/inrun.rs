@@ -17,9 +17,7 @@ use anyhow::bail;
 use crate::analysis::cg::blocking::{self, FieldErrors, Unit};
 use crate::analysis::cg::fields::{derive, Grid, Raw};
 use crate::analysis::cg::kernel::Kernel;
-use crate::analysis::cg::{
-    checks, columns, core_range, table::Table, CgOptions, Profiles, COLUMNS,
-};
+use crate::analysis::cg::{checks, core_range, table::Table, CgOptions, Profiles, COLUMNS};
 use crate::analysis::stats::integrated_autocorrelation;
 use crate::analysis::{Limit, Verdict};
 use crate::case::Case;
@@ -371,8 +369,8 @@ impl Inrun {
         // The walls' every-step mean forces when the engine's impulse covers every bin kept.
         let every_step = kept.iter().all(|&b| self.impulse_steps[b] > 0);
         let floor = match self.reference_dt {
-            Some(dt) => blocking::reference_floor(self.bin_steps as f64 * dt),
-            None => vec![0.0; COLUMNS.len()],
+            Some(dt) => blocking::Floor::reference(self.bin_steps as f64 * dt),
+            None => blocking::Floor::none(),
         };
         let errors = blocking::field_errors_with_floor(&units, &self.grid, &floor);
         let blocks = blocking::common_blocks(&errors);
@@ -734,32 +732,15 @@ pub fn errors_csv_path(dir: &Path, name: &str) -> PathBuf {
 }
 
 /// The in-run profiles' error table: per column, its τ (measured, reference, used), blocks and
-/// how its error was taken ([`blocking::errors_csv`]).
+/// how its error was taken, and its core mean with its error ([`blocking::errors_csv`]).
 pub fn errors_csv(r: &InrunResult) -> String {
-    blocking::errors_csv(&r.errors, r.units.len())
+    let core = blocking::core_means(&r.units, &r.profiles.grid, &r.errors);
+    blocking::errors_csv(&r.errors, r.units.len(), &core)
 }
 
 /// The in-run profiles as CSV: the columns of `NAME.profiles.csv`.
 pub fn csv(r: &InrunResult) -> String {
     Table::of(&r.profiles).csv()
-}
-
-/// The core mean of column `name` over `units` and its standard error from `blocks` blocks of
-/// them.
-pub fn core_mean(units: &[Unit], grid: &Grid, blocks: usize, name: &str) -> (f64, f64) {
-    let c = COLUMNS.iter().position(|x| *x == name).expect("column");
-    let core = core_range(grid);
-    let n = core.len() as f64;
-    let of = |d: &[Vec<f64>]| core.clone().map(|k| d[k][c]).sum::<f64>() / n;
-    let all: Vec<Vec<f64>> = derive(&blocking::merged(units).mean())
-        .iter()
-        .map(columns)
-        .collect();
-    let vals: Vec<f64> = blocking::block_columns(units, blocks)
-        .iter()
-        .map(|b| of(b))
-        .collect();
-    (of(&all), crate::analysis::stats::standard_error(&vals))
 }
 
 /// The in-run part of `checks.txt`: how the samples were taken, each field's autocorrelation
@@ -811,8 +792,9 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         out.push('\n');
     }
     out.push_str(
-        "core means, saves (block errors as profiles.csv) vs in-run (each field's own blocks), \
-         judged equal within 3 combined SE:\n",
+        "core means, saves vs in-run, each with its error from the series of its core mean \
+         (no tau below the core's reference, docs/statistics.md), judged equal within 3 \
+         combined SE:\n",
     );
     if core_range(&p.grid).is_empty() {
         return out;
@@ -820,8 +802,9 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
     let save_units: Vec<Unit> = saves.per_save.iter().cloned().map(Unit::of_save).collect();
     for name in ["nu", "T", "pressure", "shear_xz", "con_xz", "con_zz"] {
         let c = COLUMNS.iter().position(|x| *x == name).expect("column");
-        let (a, sa) = core_mean(&save_units, &saves.grid, saves.blocks, name);
-        let (b, sb) = core_mean(&r.units, &p.grid, r.errors.blocks[c], name);
+        let s = blocking::core_mean(&save_units, &saves.grid, save_errors, c);
+        let i = blocking::core_mean(&r.units, &p.grid, &r.errors, c);
+        let (a, sa, b, sb) = (s.mean, s.se, i.mean, i.se);
         let tol = 3.0 * (sa * sa + sb * sb).sqrt();
         let verdict = Verdict::judge(
             "",
@@ -832,7 +815,7 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
                 tolerance: tol,
             },
         )
-        .judged_if(saves.blocks >= 2 && p.blocks >= 2);
+        .judged_if(s.long_enough && i.long_enough);
         let shown = match verdict.pass() {
             Some(true) => "PASS",
             Some(false) => "FAIL",
@@ -844,8 +827,9 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
             "undefined".into()
         };
         out.push_str(&format!(
-            "{shown:4}  {name:9} saves {a:+.5} +- {sa:.2e}   in-run {b:+.5} +- {sb:.2e}   SE \
-             ratio {ratio}\n"
+            "{shown:4}  {name:9} saves {a:+.5} +- {sa:.2e} ({:.1} dof)   in-run {b:+.5} +- \
+             {sb:.2e} ({:.1} dof)   SE ratio {ratio}\n",
+            s.dof, i.dof
         ));
     }
     out

@@ -8,7 +8,7 @@
 //!   v0 = 1, against the closed form);
 //! - the bias of each profile's core mean (vx, ν, T, pressure, shear stress) against the
 //!   reference's, with its 95 % interval ([`Difference`]: Student's t with Welch's degrees of
-//!   freedom, each core mean's error from the field's own blocks), and a verdict ([`Call`]).
+//!   freedom, each core mean's error from the series of the core mean), and a verdict ([`Call`]).
 //!
 //! A **control** row runs the reference's physics again from the same state under another seed
 //! of the replicas' perturbation: its biases are noise, so about 95 % of its intervals must
@@ -180,14 +180,14 @@ impl Outcome {
 
 /// The core means of independent replicas merged. One replica: its own. R ≥ 2: their mean,
 /// with the ensemble's standard error sd/√R (sd over the replicas' means; R − 1 degrees of
-/// freedom: blocks = R), trusted whatever each replica's blocks were — independent replicas
+/// freedom), trusted whatever each replica's blocks were — independent replicas
 /// sample the slow fluctuations that one run's blocks are too short for.
 pub fn merge_core(parts: &[CoreMean]) -> CoreMean {
     match parts {
         [] => CoreMean {
             mean: f64::NAN,
             se: f64::NAN,
-            blocks: 0,
+            dof: f64::NAN,
             long_enough: false,
         },
         [one] => *one,
@@ -196,7 +196,7 @@ pub fn merge_core(parts: &[CoreMean]) -> CoreMean {
             CoreMean {
                 mean: means.iter().sum::<f64>() / means.len() as f64,
                 se: standard_error(&means),
-                blocks: means.len(),
+                dof: means.len() as f64 - 1.0,
                 long_enough: true,
             }
         }
@@ -564,7 +564,7 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
             replicas - 1
         )
     } else {
-        String::from("each core mean's error from the field's own blocks")
+        String::from("each core mean's error from the series of the core mean")
     };
     let mut s = format!(
         "Bias = core mean (z in [3, 19]) of the variant − the reference's, relative to the \
@@ -638,7 +638,7 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
 }
 
 /// The outcomes as CSV, one row per variant: what [`markdown`] needs, each core mean with its
-/// standard error, blocks and whether its errors are trusted.
+/// standard error, its degrees of freedom and whether its errors are trusted.
 pub fn csv(outcomes: &[Outcome]) -> String {
     let mut s =
         core_header("variant,dt,steps,replicas,cpu_seconds,wall_seconds,restitution_error,hash");
@@ -661,7 +661,8 @@ pub fn csv(outcomes: &[Outcome]) -> String {
 
 /// Each replica's core means as CSV, one row per replica run (a variant that gave the
 /// reference's bits has only its first): the variant, the replica, then per profile of
-/// [`FIELDS`] its core mean, standard error, blocks and whether its errors are trusted — what
+/// [`FIELDS`] its core mean, standard error, degrees of freedom and whether its errors are
+/// trusted — what
 /// [`merge_core`] merged into [`csv`]'s row.
 pub fn replicas_csv(outcomes: &[Outcome]) -> String {
     let mut s = core_header("variant,replica");
@@ -675,12 +676,12 @@ pub fn replicas_csv(outcomes: &[Outcome]) -> String {
 }
 
 /// A CSV header line: `first`, then per profile of [`FIELDS`] its core mean, standard error,
-/// blocks and trust columns.
+/// degrees-of-freedom and trust columns.
 fn core_header(first: &str) -> String {
     let mut s = String::from(first);
     for (field, _) in FIELDS {
         s.push_str(&format!(
-            ",{field}_mean,{field}_se,{field}_blocks,{field}_trusted"
+            ",{field}_mean,{field}_se,{field}_dof,{field}_trusted"
         ));
     }
     s.push('\n');
@@ -692,7 +693,7 @@ fn push_core(s: &mut String, core: &[CoreMean]) {
     for c in core {
         s.push_str(&format!(
             ",{:e},{:e},{},{}",
-            c.mean, c.se, c.blocks, c.long_enough
+            c.mean, c.se, c.dof, c.long_enough
         ));
     }
     s.push('\n');
@@ -730,7 +731,7 @@ pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
                 Ok(CoreMean {
                     mean: num(k)?,
                     se: num(k + 1)?,
-                    blocks: int(k + 2)? as usize,
+                    dof: num(k + 2)?,
                     long_enough: v[k + 3]
                         .parse()
                         .with_context(|| at(&format!("field {} is not true/false", k + 4)))?,

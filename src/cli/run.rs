@@ -232,7 +232,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             atomic::write(&errors, inrun::errors_csv(&r).as_bytes())?;
             println!("in-run profiles: {}", path.display());
             let units: Vec<Unit> = saved.per_save.iter().cloned().map(Unit::of_save).collect();
-            let floor = blocking::reference_floor(opts.save_every as f64 * case.dt());
+            let floor = blocking::Floor::reference(opts.save_every as f64 * case.dt());
             let save_errors = blocking::field_errors_with_floor(&units, &saved.grid, &floor);
             report.push_str(&inrun::report(&r, &saved, &save_errors));
             let checks = opts.out_dir.join(format!("{}.checks.txt", case.name));

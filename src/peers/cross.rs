@@ -286,7 +286,9 @@ pub fn cross_inrun(
     peer.run(np, &peer_dir, &script)?;
     let o = cg::CgOptions::for_case(&case);
     let mut own_inrun = sampling
-        .map(|s| inrun::Inrun::new(&o, &template.domain, s))
+        .map(|s| {
+            inrun::Inrun::new(&o, &template.domain, s).map(|a| a.with_reference_tau(case.dt()))
+        })
         .transpose()?;
     let mut saves = Vec::new();
     for k in 0..=steps / every {
@@ -333,7 +335,7 @@ pub fn cross_inrun(
     let inrun = match (sampling, own_inrun) {
         (Some(s), Some(acc)) => Some(InrunReport {
             sampling: s,
-            peer: peer_profiles(peer, &peer_dir, &o, &template, s)?,
+            peer: peer_profiles(peer, &peer_dir, &o, &template, s, case.dt())?,
             verdem_as_peer: acc.result().context("verdem: no in-run sample")?,
             verdem: own_profiles(own_case, state, np, s)?,
             own_convention: own_case.contact.tangential,
@@ -392,8 +394,9 @@ fn peer_profiles(
     o: &cg::CgOptions,
     template: &crate::state::Snapshot,
     s: Sampling,
+    dt: f64,
 ) -> anyhow::Result<InrunResult> {
-    let r = peer_inrun::peer_profiles(peer, dir, o, template, s)?;
+    let r = peer_inrun::peer_profiles(peer, dir, o, template, s, dt)?;
     for entry in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
         let path = entry?.path();
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
@@ -413,7 +416,8 @@ fn own_profiles(case: &Case, state: &Path, np: usize, s: Sampling) -> anyhow::Re
     };
     let mut e = engine::build(case, crate::scene::build(case, Some(state))?, &overrides);
     e.advance(0)?;
-    let mut acc = inrun::Inrun::new(&cg::CgOptions::for_case(case), &e.state().domain, s)?;
+    let mut acc = inrun::Inrun::new(&cg::CgOptions::for_case(case), &e.state().domain, s)?
+        .with_reference_tau(case.dt());
     peer_inrun::advance_observed(e.as_mut(), s.to, &mut acc)?;
     acc.result().context("verdem: no in-run sample")
 }

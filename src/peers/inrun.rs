@@ -124,7 +124,8 @@ pub fn sampling(steps: u64, every: u64, particle_every: u64) -> Sampling {
 /// intervals of `sampling`): its sample at every sampling step, read as a state of `template`
 /// ([`Peer::read_sample`]), added to an accumulator of the coarse-graining `o`, with the walls'
 /// every-step means of its [`WALLS_FILE`] when the peer writes one ([`Peer::writes_wall_means`]) (else the wall forces are
-/// those at the contact samples). A file of means that lacks an interval of the window is
+/// those at the contact samples), its errors with the benchmark's reference τ at the time step
+/// `dt` ([`Inrun::with_reference_tau`]). A file of means that lacks an interval of the window is
 /// refused, naming it.
 pub fn peer_profiles(
     peer: &dyn Peer,
@@ -132,8 +133,9 @@ pub fn peer_profiles(
     o: &CgOptions,
     template: &Snapshot,
     sampling: Sampling,
+    dt: f64,
 ) -> anyhow::Result<InrunResult> {
-    let mut acc = Inrun::new(o, &template.domain, sampling)?;
+    let mut acc = Inrun::new(o, &template.domain, sampling)?.with_reference_tau(dt);
     if peer.writes_wall_means() {
         let file = dir.join(WALLS_FILE);
         book_wall_means(&mut acc, &file, &read_wall_means(&file, sampling.every)?)?;

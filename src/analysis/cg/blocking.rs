@@ -116,6 +116,37 @@ pub struct FieldErrors {
     pub method: Vec<Method>,
     /// Standard error of each column, per grid point.
     pub se: Vec<Vec<f64>>,
+    /// The reference τ of each column's core mean in units (0 where there is none): what
+    /// [`core_mean`] takes no τ below.
+    pub core_floor: Vec<f64>,
+}
+
+/// The reference τ (in units of a series) that errors take no τ below, per column of
+/// [`COLUMNS`]: of one slice, and of the core mean (the average over the core slices).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Floor {
+    pub slice: Vec<f64>,
+    pub core: Vec<f64>,
+}
+
+impl Floor {
+    /// No reference: every τ is measured on the series itself.
+    pub fn none() -> Floor {
+        Floor {
+            slice: vec![0.0; COLUMNS.len()],
+            core: vec![0.0; COLUMNS.len()],
+        }
+    }
+
+    /// The bumpy-shear benchmark's ([`REFERENCE_TAU`], [`CORE_REFERENCE_TAU`]) in units of
+    /// `unit_time` (the time a unit of the series spans).
+    pub fn reference(unit_time: f64) -> Floor {
+        let of = |taus: &[f64]| taus.iter().map(|t| t / unit_time).collect();
+        Floor {
+            slice: of(&REFERENCE_TAU),
+            core: of(&CORE_REFERENCE_TAU),
+        }
+    }
 }
 
 /// Integrated autocorrelation time, in time units, of each column of [`COLUMNS`] at one slice of
@@ -147,10 +178,21 @@ pub const SLOW_MODE_NOTE: &str = "  note: the bed's mean x-velocity drifts with 
 /// offset of the vx profile that errors from a run's own blocks leave out (velocity units).
 pub const BED_DRIFT_SD: f64 = 0.0041;
 
-/// [`REFERENCE_TAU`] in units of `unit_time` (the time a unit of the series spans).
-pub fn reference_floor(unit_time: f64) -> Vec<f64> {
-    REFERENCE_TAU.iter().map(|t| t / unit_time).collect()
-}
+/// Integrated autocorrelation time, in time units, of each column's core mean (the average over
+/// the core slices) in the steady bumpy-shear benchmark, for in-run averaging at its default
+/// sampling: the τ with which a run's error of its core mean ([`core_mean`]) matches the spread
+/// of the core means of 58 independent runs of 144 time units (`cases/shear_flow_quick.toml`
+/// from saves 2100, 2150, …, 4000 and 2125, 2225, …, 3925 of the official full run, averaged
+/// in-run over their second half; docs/statistics.md, "The core mean's own τ"). The particle
+/// fields' core means keep the bed's coherent fluctuations, which every slice shares, so their τ
+/// is longer than a slice's; vx's and vy's follow the bed's drift (tens of time units and more:
+/// no run shorter than five of them has a trusted error of them). A contact-stress core mean is
+/// mostly the white noise of a few contacts a sample, with a slower part on top: a fraction of a
+/// bin, at the default bins (1200 steps); con_zy needs none.
+pub const CORE_REFERENCE_TAU: [f64; 26] = [
+    9.7, 9.7, 54.0, 107.0, 11.8, 5.5, 3.6, 1.5, 2.1, 1.5, 4.7, 1.7, 2.1, 1.7, 2.8, 0.10, 0.057,
+    0.074, 0.059, 0.10, 0.050, 0.082, 0.0, 0.10, 0.16, 0.080,
+];
 
 /// The integrated autocorrelation time of each column: the larger of that of its core mean
 /// (the average over the core slices, [`core_range`], or over all slices when the box has no
@@ -201,14 +243,15 @@ pub fn degrees_of_freedom(errors: &FieldErrors, c: usize, units: usize) -> f64 {
 /// Standard errors of every column without a reference τ: [`field_errors_with_floor`] with
 /// no floor.
 pub fn field_errors(units: &[Unit], grid: &Grid) -> FieldErrors {
-    field_errors_with_floor(units, grid, &[0.0; COLUMNS.len()])
+    field_errors_with_floor(units, grid, &Floor::none())
 }
 
 /// Standard errors of every column, per grid point, with τ the larger of its own
-/// ([`field_taus`]) and `floor` (units, per column): from blocks of at least
+/// ([`field_taus`]) and `floor.slice` (units, per column): from blocks of at least
 /// [`block_length_for`] τ when the units hold [`MIN_BLOCKS`] of them ([`Method::Blocks`]), else
 /// from τ ([`tau_standard_error`], [`Method::Tau`] or [`Method::TooShort`]).
-pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floor: &[f64]) -> FieldErrors {
+pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floors: &Floor) -> FieldErrors {
+    let floor = &floors.slice;
     let measured = field_taus(units, grid);
     let n = units.len();
     let tau: Vec<f64> = measured
@@ -255,7 +298,65 @@ pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floor: &[f64]) -> Fi
         blocks: chosen.iter().map(|c| c.0).collect(),
         method: chosen.iter().map(|c| c.1).collect(),
         se,
+        core_floor: floors.core.clone(),
     }
+}
+
+/// A core mean with its standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoreMean {
+    pub mean: f64,
+    pub se: f64,
+    /// The degrees of freedom of `se`: blocks − 1, or n/τ − 1 when taken from τ
+    /// ([`degrees_of_freedom`]).
+    pub dof: f64,
+    /// Whether `se` can be trusted: from blocks as long as the correlation asks, or from a τ at
+    /// least the reference's over a series [`MIN_BLOCKS`] τ long ([`Method::TooShort`] is not).
+    pub long_enough: bool,
+}
+
+/// The core mean of column `c` of [`COLUMNS`] over `units` (the mean over the core slices of the
+/// merged profile; over all slices when the box has no core) and its standard error from the
+/// series of the units' core means: from τ ([`tau_standard_error`]), the larger of the series'
+/// own integrated autocorrelation time and the core's reference ([`FieldErrors::core_floor`]).
+/// Trusted as a slice's error is ([`Method`]): when the series holds [`MIN_BLOCKS`] blocks of
+/// at least [`block_length_for`] τ, or τ is the reference's or more and the series
+/// [`MIN_BLOCKS`] τ long. The core mean keeps what moves every slice together, so its τ is not
+/// a slice's: a slice's reference ([`REFERENCE_TAU`]) does not enter.
+pub fn core_mean(units: &[Unit], grid: &Grid, errors: &FieldErrors, c: usize) -> CoreMean {
+    let core = match core_range(grid) {
+        r if r.is_empty() => 0..grid.n,
+        r => r,
+    };
+    let of = |d: &[Vec<f64>]| core.clone().map(|k| d[k][c]).sum::<f64>() / core.len() as f64;
+    let all: Vec<Vec<f64>> = derive(&merged(units).mean()).iter().map(columns).collect();
+    let series: Vec<f64> = units
+        .iter()
+        .map(|u| of(&derive(&u.mean()).iter().map(columns).collect::<Vec<_>>()))
+        .collect();
+    let n = series.len();
+    let floor = errors.core_floor[c];
+    let measured = integrated_autocorrelation(&series);
+    let tau = if measured.is_nan() && floor > 0.0 {
+        floor
+    } else {
+        measured.max(floor)
+    };
+    let long_enough = blocks_for(n, tau).1 || (floor > 0.0 && n as f64 >= MIN_BLOCKS as f64 * tau);
+    CoreMean {
+        mean: of(&all),
+        se: tau_standard_error(&series, tau),
+        // n/τ − 1 as for a slice's error from τ ([`degrees_of_freedom`]); τ is at least ½
+        dof: (n as f64 / tau.max(0.5) - 1.0).max(1.0),
+        long_enough,
+    }
+}
+
+/// Per column of [`COLUMNS`], its core mean over `units` with its error ([`core_mean`]).
+pub fn core_means(units: &[Unit], grid: &Grid, errors: &FieldErrors) -> Vec<CoreMean> {
+    (0..COLUMNS.len())
+        .map(|c| core_mean(units, grid, errors, c))
+        .collect()
 }
 
 /// The blocks' length needed by the slowest column, as a block count of `units`: the fewest
@@ -315,10 +416,12 @@ pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
 /// The per-column error table written beside in-run profiles (`NAME.profiles_inrun_errors.csv`):
 /// per column of [`COLUMNS`], τ measured, the reference τ and the τ used (all in units of the
 /// series), the blocks, the degrees of freedom of the error ([`degrees_of_freedom`]) and how it
-/// was taken (`blocks`, `tau`, or `TOO SHORT`).
-pub fn errors_csv(errors: &FieldErrors, units: usize) -> String {
+/// was taken (`blocks`, `tau`, or `TOO SHORT`); then its core mean `core[c]` ([`core_mean`])
+/// with its standard error, degrees of freedom and whether that error is trusted.
+pub fn errors_csv(errors: &FieldErrors, units: usize, core: &[CoreMean]) -> String {
     let mut s = String::from(
-        "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,method\n",
+        "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,method,core_mean,\
+         core_se,core_degrees_of_freedom,core_trusted\n",
     );
     let num = |x: f64| {
         if x.is_finite() {
@@ -327,9 +430,17 @@ pub fn errors_csv(errors: &FieldErrors, units: usize) -> String {
             String::new()
         }
     };
+    let sci = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.6e}")
+        } else {
+            String::new()
+        }
+    };
     for (c, name) in COLUMNS.iter().enumerate() {
+        let m = &core[c];
         s.push_str(&format!(
-            "{name},{},{},{},{},{},{}\n",
+            "{name},{},{},{},{},{},{},{},{},{},{}\n",
             num(errors.measured[c]),
             num(errors.floor[c]),
             num(errors.tau[c]),
@@ -339,7 +450,11 @@ pub fn errors_csv(errors: &FieldErrors, units: usize) -> String {
                 Method::Blocks => "blocks",
                 Method::Tau => "tau",
                 Method::TooShort => "TOO SHORT",
-            }
+            },
+            sci(m.mean),
+            sci(m.se),
+            num(m.dof),
+            m.long_enough,
         ));
     }
     s
@@ -398,7 +513,11 @@ mod tests {
         // that τ of its own series (stats::tau_standard_error, tested there)
         let mut floor = vec![0.0; COLUMNS.len()];
         floor[nu] = 49.5;
-        let e = field_errors_with_floor(&units, &grid, &floor);
+        let floors = Floor {
+            slice: floor,
+            core: vec![0.0; COLUMNS.len()],
+        };
+        let e = field_errors_with_floor(&units, &grid, &floors);
         assert_eq!(e.method[nu], Method::Tau);
         assert_eq!(e.tau[nu], 49.5f64.max(own.tau[nu]));
         let series: Vec<f64> = slow.iter().map(|s| 0.5 + s).collect();
@@ -411,9 +530,9 @@ mod tests {
             );
         }
         assert!((degrees_of_freedom(&e, nu, n) - (n as f64 / e.tau[nu] - 1.0)).abs() < 1e-12);
-        let csv = errors_csv(&e, n);
+        let csv = errors_csv(&e, n, &core_means(&units, &grid, &e));
         let row = csv.lines().find(|l| l.starts_with("nu,")).unwrap();
-        assert!(row.ends_with(",tau") && row.contains(",49.5000,"), "{row}");
+        assert!(row.contains(",tau,") && row.contains(",49.5000,"), "{row}");
         // a column without a reference τ keeps its own, and a constant one its blocks of one
         assert_eq!(e.method[COLUMNS.len() - 1], Method::Blocks);
     }
