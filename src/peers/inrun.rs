@@ -212,13 +212,14 @@ pub fn advance_observed(
 /// differences of a from b)`.
 pub fn markdown(rows: &[(String, String, Vec<Difference>)]) -> String {
     let mut s = String::from(
-        "Core slices (z in [3, 19]); each core mean ± its standard error from its own blocks \
-         (in-run averaging, docs/statistics.md); Δ = A − B with its 95 % interval (Student's t, \
+        "Core slices (z in [3, 19]); each core mean ± its standard error from the series of \
+         the core mean, no τ below the benchmark's core reference (in-run averaging, \
+         docs/statistics.md); Δ = A − B with its 95 % interval (Student's t, \
          Welch's degrees of freedom); real = the interval excludes 0; χ²/dof of the profiles \
          over the core slices (1 = noise); the walls' mean x-force per area (on the wall \
          from the free spheres, the mean over every step: verdem's from its impulse, a peer's \
-         from its walls.txt). \"errors too small\": a field whose blocks are shorter than \
-         its correlation asks, whose interval is then too narrow.\n\n\
+         from its walls.txt). \"errors not trusted\": a core mean whose run is shorter than \
+         five of its correlation times (vx's: the bed's drift), whose interval says little.\n\n\
          | A | B | profile | A core mean | B core mean | Δ (95 % interval) | Δ / B | χ²/dof | real? |\n\
          |---|---|---|---|---|---|---|---|---|\n",
     );
@@ -232,8 +233,8 @@ pub fn markdown(rows: &[(String, String, Vec<Difference>)]) -> String {
             let verdict = match (d.real(), d.errors_trusted()) {
                 (true, true) => "**yes**",
                 (false, true) => "no",
-                (true, false) => "**yes** (errors too small)",
-                (false, false) => "no (errors too small)",
+                (true, false) => "**yes** (errors not trusted)",
+                (false, false) => "no (errors not trusted)",
             };
             let chi2 = if d.chi2.is_nan() {
                 "—".to_string()
@@ -270,6 +271,6 @@ mod tests {
         d.a.long_enough = false;
         d.a.mean = 0.9;
         let md = markdown(&[("lmp".into(), "verdem".into(), vec![d])]);
-        assert!(md.ends_with("| no (errors too small) |\n"), "{md}");
+        assert!(md.ends_with("| no (errors not trusted) |\n"), "{md}");
     }
 }
