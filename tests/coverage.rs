@@ -74,13 +74,18 @@ fn table(units: &[Unit], grid: &Grid, errors: &blocking::FieldErrors) -> Table {
     }
 }
 
-#[test]
-fn errors_with_the_reference_tau_cover_a_slow_mode_and_with_their_own_tau_do_not() {
-    let grid = Grid {
+/// The benchmark's z-grid: 100 slices between the walls' planes 0 and 22 (core: z in [3, 19]).
+fn benchmark_grid() -> Grid {
+    Grid {
         z0: 0.0,
         z1: 22.0,
         n: 100,
-    };
+    }
+}
+
+#[test]
+fn errors_with_the_reference_tau_cover_a_slow_mode_and_with_their_own_tau_do_not() {
+    let grid = benchmark_grid();
     let nu = COLUMNS.iter().position(|c| *c == "nu").unwrap();
     let field = FIELDS.iter().position(|f| f.0 == "nu").unwrap();
     let tau = 0.5 * (tau_of(SLOW) + tau_of(FAST));
@@ -157,11 +162,7 @@ const CORE_REPLICAS: usize = 120;
 
 #[test]
 fn a_core_mean_takes_the_cores_reference_tau_and_its_errors_then_cover_a_coherent_mode() {
-    let grid = Grid {
-        z0: 0.0,
-        z1: 22.0,
-        n: 100,
-    };
+    let grid = benchmark_grid();
     let nu = COLUMNS.iter().position(|c| *c == "nu").unwrap();
     // the slices' τ, variance-weighted: (1e-4·τ_slow + 1e-3·τ_fast) / 1.1e-3 ≈ 4.4; the core
     // mean's: the fast parts average out over ~73 slices, (1e-4·τ_slow + 1.4e-5·τ_fast) /

@@ -1,7 +1,8 @@
 //! Standard errors of profiles from blocks as long as each field's own correlation: every
 //! column of [`super::COLUMNS`] gets its integrated autocorrelation time, measured on the series
 //! it is averaged from (saves, or bins of in-run samples), and its error from blocks of at
-//! least [`block_length_for`] units of that series.
+//! least [`block_length_for`] units of that series. A column's core mean (the average over the
+//! core slices) gets an error of its own, from the series of the core mean ([`core_mean`]).
 
 use super::fields::{derive, Grid, Raw};
 use super::{columns, core_range, COLUMNS};
@@ -533,6 +534,11 @@ mod tests {
         let csv = errors_csv(&e, n, &core_means(&units, &grid, &e));
         let row = csv.lines().find(|l| l.starts_with("nu,")).unwrap();
         assert!(row.contains(",tau,") && row.contains(",49.5000,"), "{row}");
+        // then the core mean, without a core reference: τ measured on the 400 values, which
+        // do not hold 5 blocks of it: not trusted
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(cells.len(), 11, "{row}");
+        assert_eq!(cells[10], "false", "{row}");
         // a column without a reference τ keeps its own, and a constant one its blocks of one
         assert_eq!(e.method[COLUMNS.len() - 1], Method::Blocks);
     }
