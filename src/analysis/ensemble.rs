@@ -136,6 +136,42 @@ pub fn coverage(
         .collect())
 }
 
+/// The replicas' own errors of one profile's core mean against the replicas' spread.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoreCoverage {
+    /// The profile's label in [`FIELDS`].
+    pub field: &'static str,
+    /// How many replicas have their core mean within ±2 of its own standard error of the
+    /// replicas' mean, of how many.
+    pub inside: usize,
+    pub replicas: usize,
+    /// The replicas' standard deviation of their core means over the root mean square of their
+    /// own errors: ≈ 1 when those errors are honest.
+    pub spread_ratio: f64,
+}
+
+/// The coverage of one profile's core means, each replica's `(core mean, its own standard
+/// error)` in `means` (at least two replicas).
+pub fn core_coverage(field: &'static str, means: &[(f64, f64)]) -> CoreCoverage {
+    let r = means.len();
+    let mean = means.iter().map(|m| m.0).sum::<f64>() / r as f64;
+    let spread = means.iter().map(|m| (m.0 - mean).powi(2)).sum::<f64>() / (r as f64 - 1.0);
+    let own = means.iter().map(|m| m.1 * m.1).sum::<f64>() / r as f64;
+    CoreCoverage {
+        field,
+        inside: means
+            .iter()
+            .filter(|m| (m.0 - mean).abs() <= 2.0 * m.1)
+            .count(),
+        replicas: r,
+        spread_ratio: if own > 0.0 {
+            (spread / own).sqrt()
+        } else {
+            f64::INFINITY
+        },
+    }
+}
+
 /// The fraction of replicas within ±2 of their own block error of the ensemble mean when
 /// those errors are honest (the values Gaussian, the blocks independent): a replica's deviation
 /// from a mean that includes it has variance σ²(1 − 1/R), and its block error estimates σ from
@@ -195,6 +231,21 @@ pub fn student_t_within(x: f64, dof: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn core_coverage_counts_replicas_within_their_own_two_errors_and_the_spread_over_them() {
+        // core means 0, 0, 3 → mean 1; deviations −1, −1, +2; own errors 0.6, 0.4, 0.9: the
+        // first inside (1 ≤ 1.2), the second not (1 > 0.8), the third not (2 > 1.8)
+        let c = core_coverage("nu", &[(0.0, 0.6), (0.0, 0.4), (3.0, 0.9)]);
+        assert_eq!((c.inside, c.replicas), (1, 3));
+        // spread: variance (1 + 1 + 4)/2 = 3; own: (0.36 + 0.16 + 0.81)/3
+        let expected = (3.0f64 / ((0.36 + 0.16 + 0.81) / 3.0)).sqrt();
+        assert!(
+            (c.spread_ratio - expected).abs() < 1e-12,
+            "{}",
+            c.spread_ratio
+        );
+    }
 
     /// A table on the benchmark's grid (100 slices of [0, 22]) whose every column is `value`
     /// at every point, with error `se`.

@@ -26,7 +26,7 @@ use sha2::{Digest, Sha256};
 use crate::analysis::cg::blocking;
 use crate::analysis::cg::table::Table;
 use crate::analysis::cg::{self, CgOptions};
-use crate::analysis::ensemble::{self as merge, Coverage};
+use crate::analysis::ensemble::{self as merge, CoreCoverage, Coverage};
 use crate::analysis::inrun::{self, Inrun};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
@@ -446,7 +446,7 @@ impl Plan {
             inrun,
         };
         atomic::write(&merged_path(&self.out, name), merged.table.csv().as_bytes())?;
-        if let Some((t, _)) = &merged.inrun {
+        if let Some((t, _, _)) = &merged.inrun {
             atomic::write(&merged_inrun_path(&self.out, name), t.csv().as_bytes())?;
         }
         atomic::write(&summary_path(&self.out, name), merged.toml(self).as_bytes())?;
@@ -522,13 +522,10 @@ fn in_run(
 }
 
 /// The ensemble of the replicas' in-run profiles and the coverage of their own errors, the
-/// expected coverage from each profile's fewest degrees of freedom over the replicas; `None`
-/// when a replica has none.
-fn merge_inrun(
-    plan: &Plan,
-    name: &str,
-    records: &[Record],
-) -> anyhow::Result<Option<(Table, Vec<Coverage>)>> {
+/// expected coverage from each profile's fewest degrees of freedom over the replicas, and the
+/// coverage of their core means' own errors (none when a replica's error table has no core
+/// columns); `None` when a replica has no in-run profiles.
+fn merge_inrun(plan: &Plan, name: &str, records: &[Record]) -> anyhow::Result<Option<InrunMerged>> {
     let paths: Vec<PathBuf> = (0..plan.replicas)
         .map(|k| inrun::csv_path(&replica_dir(&plan.out, k), name))
         .collect();
@@ -552,7 +549,66 @@ fn merge_inrun(
             .fold(f64::INFINITY, f64::min);
         c.expected = merge::expected_coverage_dof(tables.len(), dof);
     }
-    Ok(Some((table, coverage)))
+    let mut per_replica = Vec::new();
+    for k in 0..plan.replicas {
+        match core_means(&inrun::errors_csv_path(&replica_dir(&plan.out, k), name))? {
+            Some(m) => per_replica.push(m),
+            None => return Ok(Some((table, coverage, Vec::new()))),
+        }
+    }
+    let core = cg::FIELDS
+        .iter()
+        .enumerate()
+        .map(|(f, &(field, _))| {
+            let means: Vec<(f64, f64)> = per_replica.iter().map(|m| m[f]).collect();
+            merge::core_coverage(field, &means)
+        })
+        .collect();
+    Ok(Some((table, coverage, core)))
+}
+
+/// The ensemble of the replicas' in-run profiles, the coverage of their per-slice errors and
+/// that of their core means' errors.
+pub type InrunMerged = (Table, Vec<Coverage>, Vec<CoreCoverage>);
+
+/// Per benchmark profile of [`cg::FIELDS`], the core mean and its own standard error of an
+/// in-run error table (`NAME.profiles_inrun_errors.csv`, [`inrun::errors_csv`]); `None` when
+/// the table has no core columns (written before they were added). A missing row or a value
+/// that is not a finite number is refused, naming the file, line and column.
+fn core_means(path: &Path) -> anyhow::Result<Option<Vec<(f64, f64)>>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let at = |name: &str| header.iter().position(|h| *h == name);
+    let (Some(mean_at), Some(se_at)) = (at("core_mean"), at("core_se")) else {
+        return Ok(None);
+    };
+    let mut out = Vec::new();
+    for &(field, col) in &cg::FIELDS {
+        let column = cg::COLUMNS[col];
+        let (n, line) = lines
+            .clone()
+            .enumerate()
+            .find(|(_, l)| l.split(',').next() == Some(column))
+            .with_context(|| format!("{}: no row of column {column} ({field})", path.display()))?;
+        let cells: Vec<&str> = line.split(',').collect();
+        let value = |at: usize, what: &str| -> anyhow::Result<f64> {
+            cells
+                .get(at)
+                .and_then(|c| c.parse::<f64>().ok())
+                .filter(|x| x.is_finite())
+                .with_context(|| {
+                    format!(
+                        "{}: line {}: {what} of {column} is not a finite number",
+                        path.display(),
+                        n + 2
+                    )
+                })
+        };
+        out.push((value(mean_at, "core_mean")?, value(se_at, "core_se")?));
+    }
+    Ok(Some(out))
 }
 
 /// Path of the merged in-run profiles, `DIR/NAME.profiles_inrun_ensemble.csv`.
@@ -592,9 +648,9 @@ pub struct Merged {
     pub coverage: Vec<Coverage>,
     /// The fewest blocks any replica's errors came from.
     pub blocks: usize,
-    /// The ensemble of the replicas' in-run profiles and the coverage of their own (per-field)
-    /// errors, when every replica has in-run profiles.
-    pub inrun: Option<(Table, Vec<Coverage>)>,
+    /// The ensemble of the replicas' in-run profiles, the coverage of their own (per-field)
+    /// errors and of their core means' errors, when every replica has in-run profiles.
+    pub inrun: Option<InrunMerged>,
 }
 
 impl Merged {
@@ -620,7 +676,7 @@ impl Merged {
                 r.saves
             );
         }
-        let inrun = self.inrun.iter().flat_map(|(_, c)| c);
+        let inrun = self.inrun.iter().flat_map(|(_, c, _)| c);
         for (table, c) in std::iter::repeat_n("field", self.coverage.len())
             .zip(&self.coverage)
             .chain(std::iter::repeat("field_inrun").zip(inrun))
@@ -636,6 +692,13 @@ impl Merged {
                 c.pairs,
                 c.expected,
                 c.spread_ratio
+            );
+        }
+        for c in self.inrun.iter().flat_map(|(_, _, c)| c) {
+            let _ = writeln!(
+                s,
+                "\n[[core_inrun]]\nname = {:?}\ninside = {}\nreplicas = {}\nspread_over_error = {}",
+                c.field, c.inside, c.replicas, c.spread_ratio
             );
         }
         s
@@ -660,12 +723,26 @@ impl Merged {
             );
         }
         s.push_str(&coverage_table(&self.coverage));
-        if let Some((_, c)) = &self.inrun {
+        if let Some((_, c, core)) = &self.inrun {
             let _ = writeln!(
                 s,
                 "in-run profiles, each field's own errors (no tau below the benchmark's reference):"
             );
             s.push_str(&coverage_table(c));
+            if !core.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "in-run core means, each replica's own error (the series of its core mean): \
+                     replicas within ±2 errors of their mean, and their spread over those errors"
+                );
+                for c in core {
+                    let _ = writeln!(
+                        s,
+                        "{:<9} {:>3} of {:<3} spread/SE {:.2}",
+                        c.field, c.inside, c.replicas, c.spread_ratio
+                    );
+                }
+            }
         }
         let _ = writeln!(
             s,
