@@ -117,10 +117,12 @@ pub fn t975(dof: f64) -> f64 {
 /// stress), then in the x-force per area on the bottom and top walls ([`wall_shear`], no χ²:
 /// NaN); the two must share the grid.
 pub fn differences(a: &InrunResult, b: &InrunResult) -> Vec<Difference> {
+    let core = |r: &InrunResult| cg::blocking::core_means(&r.units, &r.profiles.grid, &r.errors);
+    let (core_a, core_b) = (core(a), core(b));
     let profiles = FIELDS.iter().map(|&(field, col)| Difference {
         field,
-        a: CoreMean::of(a, COLUMNS[col]),
-        b: CoreMean::of(b, COLUMNS[col]),
+        a: core_a[col],
+        b: core_b[col],
         chi2: cg::chi2(&a.profiles, &b.profiles, col),
     });
     let walls = [(0, "bottom wall Fx/A"), (1, "top wall Fx/A")].map(|(g, field)| Difference {

@@ -17,12 +17,13 @@ use anyhow::bail;
 use crate::analysis::cg::blocking::{self, FieldErrors, Unit};
 use crate::analysis::cg::fields::{derive, Grid, Raw};
 use crate::analysis::cg::kernel::Kernel;
-use crate::analysis::cg::{checks, core_range, table::Table, CgOptions, Profiles, COLUMNS};
+use crate::analysis::cg::{checks, core_range, table::Table, CgOptions, Profiles, COLUMNS, FIELDS};
 use crate::analysis::stats::integrated_autocorrelation;
 use crate::analysis::{Limit, Verdict};
 use crate::case::Case;
 use crate::contact::PairInput;
 use crate::io::checkpoint::Reader;
+use crate::io::{csv_table, read_text, FormatError};
 use crate::run::Observer;
 use crate::state::{Domain, SampledContact, Snapshot};
 use crate::step::Engine;
@@ -738,6 +739,52 @@ pub fn errors_csv(r: &InrunResult) -> String {
     blocking::errors_csv(&r.errors, r.units.len(), &core)
 }
 
+/// Per benchmark profile of [`FIELDS`], the core mean and its own standard error in an error
+/// table written by [`errors_csv`]; `None` when the table has no core columns (written before
+/// they were added, 2026-11-25). A missing row, or a core mean or error that is not a finite
+/// number, is refused, naming the file, the line and the field.
+pub fn read_core_means(path: &Path) -> Result<Option<Vec<(f64, f64)>>, FormatError> {
+    let (file, text) = read_text(path)?;
+    let fail = |line: usize, msg: String| FormatError {
+        file: file.clone(),
+        line,
+        msg,
+    };
+    let mut records = csv_table::records(&file, &text, false);
+    let Some((_, header)) = records.next().transpose()? else {
+        return Err(fail(0, "empty: no header".into()));
+    };
+    let at = |name: &str| header.iter().position(|h| h == name);
+    let (Some(mean_at), Some(se_at)) = (at("core_mean"), at("core_se")) else {
+        return Ok(None);
+    };
+    let rows = records.collect::<Result<Vec<_>, _>>()?;
+    FIELDS
+        .iter()
+        .map(|&(field, col)| {
+            let column = COLUMNS[col];
+            let (line, row) = rows
+                .iter()
+                .find(|(_, r)| r.get(0) == Some(column))
+                .ok_or_else(|| fail(0, format!("no row of column {column} ({field})")))?;
+            let value = |at: usize, name: &str| {
+                let cell = row.get(at).unwrap_or_default();
+                cell.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        fail(
+                            *line,
+                            format!("field {name} of {column}: not a finite number: {cell:?}"),
+                        )
+                    })
+            };
+            Ok((value(mean_at, "core_mean")?, value(se_at, "core_se")?))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
 /// The in-run profiles as CSV: the columns of `NAME.profiles.csv`.
 pub fn csv(r: &InrunResult) -> String {
     Table::of(&r.profiles).csv()
@@ -800,10 +847,11 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         return out;
     }
     let save_units: Vec<Unit> = saves.per_save.iter().cloned().map(Unit::of_save).collect();
+    let of_saves = blocking::core_means(&save_units, &saves.grid, save_errors);
+    let in_run = blocking::core_means(&r.units, &p.grid, &r.errors);
     for name in ["nu", "T", "pressure", "shear_xz", "con_xz", "con_zz"] {
         let c = COLUMNS.iter().position(|x| *x == name).expect("column");
-        let s = blocking::core_mean(&save_units, &saves.grid, save_errors, c);
-        let i = blocking::core_mean(&r.units, &p.grid, &r.errors, c);
+        let (s, i) = (of_saves[c], in_run[c]);
         let (a, sa, b, sb) = (s.mean, s.se, i.mean, i.se);
         let tol = 3.0 * (sa * sa + sb * sb).sqrt();
         let verdict = Verdict::judge(
@@ -838,6 +886,48 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn core_means_are_read_back_from_the_error_table_or_refused_naming_line_and_field() {
+        let dir = std::env::temp_dir().join(format!("verdem_core_means_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.profiles_inrun_errors.csv");
+        let header = "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,\
+                      method,core_mean,core_se,core_degrees_of_freedom,core_trusted";
+        // one row per benchmark profile, its core mean k + 1 and error (k + 1)/100, in another
+        // order than FIELDS', with a column the reader does not need between them
+        let rows = ["pressure", "rho", "shear_xz", "T", "nu", "vx"]
+            .iter()
+            .enumerate()
+            .map(|(k, c)| format!("{c},1,1,1,5,4,tau,{}e0,{}e-2,9.0,true", k + 1, k + 1))
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(&path, format!("{header}\n{rows}\n")).unwrap();
+        let got = read_core_means(&path).unwrap().unwrap();
+        // FIELDS: vx, nu, T, pressure, shear
+        assert_eq!(
+            got,
+            vec![
+                (6.0, 0.06),
+                (5.0, 0.05),
+                (4.0, 0.04),
+                (1.0, 0.01),
+                (3.0, 0.03)
+            ]
+        );
+        // a table written before the core columns: none
+        std::fs::write(&path, "column,tau_measured\nnu,1\n").unwrap();
+        assert_eq!(read_core_means(&path).unwrap(), None);
+        // an empty core mean (what the writer leaves for a non-finite one) is refused
+        let bad = rows.replace("T,1,1,1,5,4,tau,4e0", "T,1,1,1,5,4,tau,");
+        std::fs::write(&path, format!("{header}\n{bad}\n")).unwrap();
+        let e = read_core_means(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(":5: field core_mean of T: not a finite number"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     /// A wall mean is booked as the engine's impulse over the same steps would be: into the bin
     /// of its last step, K times the mean with K steps, and only when all its steps are in

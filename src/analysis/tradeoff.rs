@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 
-use crate::analysis::cg::COLUMNS;
+use crate::analysis::cg::blocking;
 use crate::analysis::cg::FIELDS;
 use crate::analysis::difference::{CoreMean, Difference};
 use crate::analysis::inrun::{self, Inrun};
@@ -315,12 +315,8 @@ pub fn run(
                 &inrun::errors_csv_path(&dir, &v.case.name),
                 inrun::errors_csv(&r).as_bytes(),
             )?;
-            parts.push(
-                FIELDS
-                    .iter()
-                    .map(|&(_, c)| CoreMean::of(&r, COLUMNS[c]))
-                    .collect::<Vec<_>>(),
-            );
+            let core = blocking::core_means(&r.units, &r.profiles.grid, &r.errors);
+            parts.push(FIELDS.iter().map(|&(_, c)| core[c]).collect::<Vec<_>>());
             if k == 0 {
                 hash = summary.hash;
             }

@@ -551,7 +551,7 @@ fn merge_inrun(plan: &Plan, name: &str, records: &[Record]) -> anyhow::Result<Op
     }
     let mut per_replica = Vec::new();
     for k in 0..plan.replicas {
-        match core_means(&inrun::errors_csv_path(&replica_dir(&plan.out, k), name))? {
+        match inrun::read_core_means(&inrun::errors_csv_path(&replica_dir(&plan.out, k), name))? {
             Some(m) => per_replica.push(m),
             None => return Ok(Some((table, coverage, Vec::new()))),
         }
@@ -570,46 +570,6 @@ fn merge_inrun(plan: &Plan, name: &str, records: &[Record]) -> anyhow::Result<Op
 /// The ensemble of the replicas' in-run profiles, the coverage of their per-slice errors and
 /// that of their core means' errors.
 pub type InrunMerged = (Table, Vec<Coverage>, Vec<CoreCoverage>);
-
-/// Per benchmark profile of [`cg::FIELDS`], the core mean and its own standard error of an
-/// in-run error table (`NAME.profiles_inrun_errors.csv`, [`inrun::errors_csv`]); `None` when
-/// the table has no core columns (written before they were added). A missing row or a value
-/// that is not a finite number is refused, naming the file, line and column.
-fn core_means(path: &Path) -> anyhow::Result<Option<Vec<(f64, f64)>>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let at = |name: &str| header.iter().position(|h| *h == name);
-    let (Some(mean_at), Some(se_at)) = (at("core_mean"), at("core_se")) else {
-        return Ok(None);
-    };
-    let mut out = Vec::new();
-    for &(field, col) in &cg::FIELDS {
-        let column = cg::COLUMNS[col];
-        let (n, line) = lines
-            .clone()
-            .enumerate()
-            .find(|(_, l)| l.split(',').next() == Some(column))
-            .with_context(|| format!("{}: no row of column {column} ({field})", path.display()))?;
-        let cells: Vec<&str> = line.split(',').collect();
-        let value = |at: usize, what: &str| -> anyhow::Result<f64> {
-            cells
-                .get(at)
-                .and_then(|c| c.parse::<f64>().ok())
-                .filter(|x| x.is_finite())
-                .with_context(|| {
-                    format!(
-                        "{}: line {}: {what} of {column} is not a finite number",
-                        path.display(),
-                        n + 2
-                    )
-                })
-        };
-        out.push((value(mean_at, "core_mean")?, value(se_at, "core_se")?));
-    }
-    Ok(Some(out))
-}
 
 /// Path of the merged in-run profiles, `DIR/NAME.profiles_inrun_ensemble.csv`.
 pub fn merged_inrun_path(out: &Path, name: &str) -> PathBuf {

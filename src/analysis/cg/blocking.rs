@@ -203,10 +203,7 @@ pub fn field_taus(units: &[Unit], grid: &Grid) -> Vec<f64> {
         .iter()
         .map(|u| derive(&u.mean()).iter().map(columns).collect())
         .collect();
-    let core = match core_range(grid) {
-        r if r.is_empty() => 0..grid.n,
-        r => r,
-    };
+    let core = core_or_all(grid);
     (0..COLUMNS.len())
         .map(|c| {
             let core_mean: Vec<f64> = per_unit
@@ -258,16 +255,12 @@ pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floors: &Floor) -> F
     let tau: Vec<f64> = measured
         .iter()
         .zip(floor)
-        .map(|(&m, &f)| if m.is_nan() && f > 0.0 { f } else { m.max(f) })
+        .map(|(&m, &f)| floored(m, f))
         .collect();
     let chosen: Vec<(usize, Method)> = tau
         .iter()
         .zip(floor)
-        .map(|(&t, &f)| match blocks_for(n, t) {
-            (b, true) => (b, Method::Blocks),
-            (b, false) if f > 0.0 && n as f64 >= MIN_BLOCKS as f64 * t => (b, Method::Tau),
-            (b, false) => (b, Method::TooShort),
-        })
+        .map(|(&t, &f)| method(n, t, f))
         .collect();
     let per_unit: Vec<Vec<Vec<f64>>> = units
         .iter()
@@ -325,39 +318,75 @@ pub struct CoreMean {
 /// [`MIN_BLOCKS`] τ long. The core mean keeps what moves every slice together, so its τ is not
 /// a slice's: a slice's reference ([`REFERENCE_TAU`]) does not enter.
 pub fn core_mean(units: &[Unit], grid: &Grid, errors: &FieldErrors, c: usize) -> CoreMean {
-    let core = match core_range(grid) {
-        r if r.is_empty() => 0..grid.n,
-        r => r,
-    };
-    let of = |d: &[Vec<f64>]| core.clone().map(|k| d[k][c]).sum::<f64>() / core.len() as f64;
-    let all: Vec<Vec<f64>> = derive(&merged(units).mean()).iter().map(columns).collect();
-    let series: Vec<f64> = units
-        .iter()
-        .map(|u| of(&derive(&u.mean()).iter().map(columns).collect::<Vec<_>>()))
-        .collect();
-    let n = series.len();
-    let floor = errors.core_floor[c];
-    let measured = integrated_autocorrelation(&series);
-    let tau = if measured.is_nan() && floor > 0.0 {
-        floor
-    } else {
-        measured.max(floor)
-    };
-    let long_enough = blocks_for(n, tau).1 || (floor > 0.0 && n as f64 >= MIN_BLOCKS as f64 * tau);
-    CoreMean {
-        mean: of(&all),
-        se: tau_standard_error(&series, tau),
-        // n/τ − 1 as for a slice's error from τ ([`degrees_of_freedom`]); τ is at least ½
-        dof: (n as f64 / tau.max(0.5) - 1.0).max(1.0),
-        long_enough,
-    }
+    let (all, series) = core_series(units, grid);
+    core_mean_of(all[c], &series[c], errors.core_floor[c])
 }
 
 /// Per column of [`COLUMNS`], its core mean over `units` with its error ([`core_mean`]).
 pub fn core_means(units: &[Unit], grid: &Grid, errors: &FieldErrors) -> Vec<CoreMean> {
+    let (all, series) = core_series(units, grid);
     (0..COLUMNS.len())
-        .map(|c| core_mean(units, grid, errors, c))
+        .map(|c| core_mean_of(all[c], &series[c], errors.core_floor[c]))
         .collect()
+}
+
+/// Per column of [`COLUMNS`]: the core mean of the merged `units`, and the series of each
+/// unit's core mean ([`core_or_all`]).
+fn core_series(units: &[Unit], grid: &Grid) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let core = core_or_all(grid);
+    let of = |u: &Unit| -> Vec<f64> {
+        let d: Vec<Vec<f64>> = derive(&u.mean()).iter().map(columns).collect();
+        (0..COLUMNS.len())
+            .map(|c| core.clone().map(|k| d[k][c]).sum::<f64>() / core.len() as f64)
+            .collect()
+    };
+    let per_unit: Vec<Vec<f64>> = units.iter().map(of).collect();
+    let series = (0..COLUMNS.len())
+        .map(|c| per_unit.iter().map(|u| u[c]).collect())
+        .collect();
+    (of(&merged(units)), series)
+}
+
+/// [`core_mean`] of one column: its merged core mean `mean`, the series of the units' core
+/// means and the core's reference τ `floor` (units).
+fn core_mean_of(mean: f64, series: &[f64], floor: f64) -> CoreMean {
+    let n = series.len();
+    let tau = floored(integrated_autocorrelation(series), floor);
+    CoreMean {
+        mean,
+        se: tau_standard_error(series, tau),
+        // n/τ − 1 as for a slice's error from τ ([`degrees_of_freedom`]); τ is at least ½
+        dof: (n as f64 / tau.max(0.5) - 1.0).max(1.0),
+        long_enough: method(n, tau, floor).1 != Method::TooShort,
+    }
+}
+
+/// The core slices of `grid` ([`core_range`]), or all of them when the box has no core.
+fn core_or_all(grid: &Grid) -> std::ops::Range<usize> {
+    match core_range(grid) {
+        r if r.is_empty() => 0..grid.n,
+        r => r,
+    }
+}
+
+/// τ measured on a series, no smaller than the reference `floor` (0: none); the reference when
+/// the series is too short to measure τ (NaN).
+fn floored(measured: f64, floor: f64) -> f64 {
+    if measured.is_nan() && floor > 0.0 {
+        floor
+    } else {
+        measured.max(floor)
+    }
+}
+
+/// How the error of a series of `n` units with τ `tau` is taken, with the reference `floor`
+/// (0: none), and from how many blocks: see [`Method`].
+fn method(n: usize, tau: f64, floor: f64) -> (usize, Method) {
+    match blocks_for(n, tau) {
+        (b, true) => (b, Method::Blocks),
+        (b, false) if floor > 0.0 && n as f64 >= MIN_BLOCKS as f64 * tau => (b, Method::Tau),
+        (b, false) => (b, Method::TooShort),
+    }
 }
 
 /// The blocks' length needed by the slowest column, as a block count of `units`: the fewest
