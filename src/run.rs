@@ -11,6 +11,7 @@ use anyhow::{bail, Context};
 use crate::io::checkpoint::{Ledgers, Resumed, RunRecord};
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
 use crate::io::{atomic, csv_table, mercury, vtk};
+use crate::state::SampledContact;
 use crate::step::{Engine, Reading, StageTimes};
 
 /// Options of one run.
@@ -224,6 +225,14 @@ pub trait Observer {
     fn start(&mut self, _engine: &dyn Engine) {}
     /// Looks at the engine's current step.
     fn observe(&mut self, engine: &dyn Engine);
+    /// The interval of the contact samples it wants the engine to take inside its runs, without
+    /// a stop ([`Engine::sample_contacts_every`]; 0, the default: none).
+    fn contact_every(&self) -> u64 {
+        0
+    }
+    /// Takes the contact samples (by step, in step order) the engine took since the run loop's
+    /// last stop; handed over at every stop, before anything else happens there.
+    fn contacts(&mut self, _samples: &[(u64, Vec<SampledContact>)]) {}
     /// Everything it has gathered, as bytes its owner can restore it from: written into the
     /// run's checkpoints, so that a resumed run's observer continues where it was.
     fn state(&self) -> Vec<u8>;
@@ -342,6 +351,8 @@ fn run_from(
         )?),
     };
     let bar = progress_bar(opts, start_step);
+    engine.sample_contacts_every(observer.as_deref().map_or(0, |o| o.contact_every()));
+    engine.take_contact_samples();
     if let Some(o) = observer.as_deref_mut() {
         o.start(engine);
     }
@@ -410,11 +421,16 @@ fn run_from(
             next = next.min(s);
         }
         engine.advance(next - step).map_err(|f| kept.stopped(f))?;
+        let samples = engine.take_contact_samples();
+        if let Some(o) = observer.as_deref_mut() {
+            o.contacts(&samples);
+        }
         if let Some(b) = &bar {
             b.set_position(engine.state().step);
             b.set_message(format!("t = {:.3}", engine.state().time));
         }
     };
+    engine.sample_contacts_every(0);
     if let Some(b) = bar {
         b.finish_and_clear();
     }

@@ -269,3 +269,79 @@ fn a_run_writes_its_in_run_profiles_and_judges_them_beside_the_saves() {
     let mut words = checks.split(|c: char| !c.is_alphanumeric());
     assert!(!words.any(|w| w == "NaN" || w == "inf"), "{checks}");
 }
+
+/// The contact samples the engine takes inside its runs (`Engine::sample_contacts_every`) are,
+/// bit for bit, what a stop at each sampled step reads (`Engine::contact_sample`), on one thread
+/// and on two, across rebuilds and across the calls that split the steps.
+#[test]
+fn contact_samples_taken_inside_a_run_are_those_of_a_stop() {
+    const K: u64 = 25;
+    const STEPS: u64 = 3000;
+    let case = Case::load(&common::root().join("cases/shear_flow_steady.toml")).unwrap();
+    let init = common::root().join("golden/full_run/shear_flow.final.data");
+    let engine = |threads| {
+        let o = Overrides {
+            threads: Some(threads),
+            ..Overrides::default()
+        };
+        common::engine(&case, Some(&init), o)
+    };
+    let mut stopped = engine(1);
+    let mut expected = Vec::new();
+    for _ in 0..STEPS / K {
+        stopped.advance(K).unwrap();
+        expected.push((stopped.state().step, stopped.contact_sample()));
+    }
+    let contacts: usize = expected.iter().map(|(_, c)| c.len()).sum();
+    assert!(contacts > 100, "only {contacts} contacts sampled");
+    assert!(
+        stopped.counters().rebuilds >= 3,
+        "no rebuild among the samples"
+    );
+    for threads in [1, 2] {
+        let mut e = engine(threads);
+        e.sample_contacts_every(K);
+        e.advance(1010).unwrap();
+        e.advance(STEPS - 1010).unwrap();
+        assert_eq!(e.take_contact_samples(), expected, "{threads} threads");
+        assert!(e.take_contact_samples().is_empty());
+        e.sample_contacts_every(0);
+        e.advance(K).unwrap();
+        assert!(
+            e.take_contact_samples().is_empty(),
+            "sampled after it was turned off"
+        );
+    }
+}
+
+/// `verdem cross`'s loop (`peers::inrun::advance_observed`) feeds an in-run accumulator exactly
+/// as `verdem run`'s does: the same profiles and errors, bit for bit, the contact samples taken
+/// inside the steps included.
+#[test]
+fn the_cross_loop_averages_in_run_as_the_run_loop_does() {
+    let (case, _) = steady();
+    let sampling = Sampling {
+        every: 25,
+        particle_every: 1200,
+        from: 2400,
+        to: 9600,
+    };
+    let outputs = |via_run: bool| {
+        let (_, mut e) = steady();
+        let mut acc = Inrun::new(&CgOptions::for_case(&case), &e.state().domain, sampling)
+            .unwrap()
+            .with_reference_tau(case.dt());
+        if via_run {
+            let dir = tempfile::tempdir().unwrap();
+            let opts = options(dir.path(), sampling.to, 4800, false);
+            run::run_observed(e.as_mut(), &opts, false, Some(&mut acc)).unwrap();
+        } else {
+            e.advance(0).unwrap();
+            verdem::peers::inrun::advance_observed(e.as_mut(), sampling.to, &mut acc).unwrap();
+        }
+        let r = acc.result().expect("samples");
+        assert_eq!(r.contact_samples, (sampling.to - sampling.from) / sampling.every);
+        [verdem::analysis::inrun::csv(&r), verdem::analysis::inrun::errors_csv(&r)]
+    };
+    assert_eq!(outputs(true), outputs(false));
+}

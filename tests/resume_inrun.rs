@@ -13,6 +13,7 @@ use verdem::analysis::inrun::{self, Inrun};
 use verdem::engine::Overrides;
 use verdem::io::checkpoint;
 use verdem::run::{self, Observer, RunOptions};
+use verdem::state::SampledContact;
 use verdem::step::Engine;
 
 /// Steps of the run, a save every [`SAVE_EVERY`]: saves 0 to 8, the in-run window over the
@@ -71,6 +72,12 @@ impl Observer for StopAt {
         if step == self.at {
             self.stop.store(true, Ordering::Relaxed);
         }
+    }
+    fn contact_every(&self) -> u64 {
+        self.inrun.contact_every()
+    }
+    fn contacts(&mut self, samples: &[(u64, Vec<SampledContact>)]) {
+        self.inrun.contacts(samples);
     }
     fn state(&self) -> Vec<u8> {
         self.inrun.state()

@@ -370,7 +370,11 @@ impl Inrun {
         // The walls' every-step mean forces when the engine's impulse covers every bin kept.
         let every_step = kept.iter().all(|&b| self.impulse_steps[b] > 0);
         let floor = match self.reference_dt {
-            Some(dt) => blocking::Floor::reference(self.bin_steps as f64 * dt),
+            Some(dt) => {
+                let s = self.sampling;
+                let (k, kp) = (s.every as f64 * dt, s.particle_every as f64 * dt);
+                blocking::Floor::inrun(self.bin_steps as f64 * dt, k, kp)
+            }
             None => blocking::Floor::none(),
         };
         let errors = blocking::field_errors_with_floor(&units, &self.grid, &floor);
@@ -428,16 +432,32 @@ impl Inrun {
     }
 }
 
-/// The run loop stops at `from` too, where the walls' impulse starts to count, and at each
-/// contact sample after it, where the impulse since the last stop is booked.
+/// The run loop stops at `from`, where the walls' impulse starts to count, and at each particle
+/// sample after it (the end of a bin), where the impulse since the last stop is booked; the
+/// engine takes the contact samples between them inside its runs.
 impl Observer for Inrun {
     fn next_after(&self, step: u64) -> Option<u64> {
         let s = self.sampling;
         if step < s.from {
             return Some(s.from);
         }
-        let next = (step / s.every + 1) * s.every;
+        let next = (step / s.particle_every + 1) * s.particle_every;
         (next <= s.to).then_some(next)
+    }
+
+    fn contact_every(&self) -> u64 {
+        self.sampling.every
+    }
+
+    /// Books the contact samples in the window but those of a particle sample's step, which
+    /// [`Inrun::observe`] takes with the particles.
+    fn contacts(&mut self, samples: &[(u64, Vec<SampledContact>)]) {
+        let s = self.sampling;
+        for (step, contacts) in samples {
+            if *step > s.from && *step <= s.to && !step.is_multiple_of(s.particle_every) {
+                self.sample_contacts(*step, contacts);
+            }
+        }
     }
 
     /// Marks the walls' impulse where the run starts in the window, unless a checkpoint's
@@ -458,11 +478,8 @@ impl Observer for Inrun {
         if step == self.sampling.from {
             return;
         }
-        // A particle sample needs every particle; a contact sample only the contacts.
         if step.is_multiple_of(self.sampling.particle_every) {
             self.sample(&engine.snapshot(), true);
-        } else {
-            self.sample_contacts(step, &engine.contact_sample());
         }
     }
 

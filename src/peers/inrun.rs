@@ -185,19 +185,23 @@ fn book_wall_means(acc: &mut Inrun, file: &Path, means: &[WallMean]) -> anyhow::
 
 /// Advances `e` by `steps` steps, stopping at the steps `observer` asks for and showing it the
 /// engine there, its forces evaluated (as `verdem run` does: the observer first looks at the
-/// step it starts from, where an in-run accumulator marks the walls' impulse); where it stops
-/// does not change the steps.
+/// step it starts from, where an in-run accumulator marks the walls' impulse, and takes the
+/// contact samples the engine took inside its steps at every stop); where it stops does not
+/// change the steps.
 pub fn advance_observed(
     e: &mut dyn Engine,
     steps: u64,
     observer: &mut dyn Observer,
 ) -> anyhow::Result<()> {
+    e.sample_contacts_every(observer.contact_every());
+    e.take_contact_samples();
     observer.start(e);
     let end = e.state().step + steps;
     while e.state().step < end {
         let step = e.state().step;
         let next = observer.next_after(step).map_or(end, |s| s.min(end));
         e.advance(next - step)?;
+        observer.contacts(&e.take_contact_samples());
         if observer.next_after(next - 1) == Some(next) {
             if !e.state().forces_ready {
                 e.advance(0)?;
@@ -205,6 +209,7 @@ pub fn advance_observed(
             observer.observe(e);
         }
     }
+    e.sample_contacts_every(0);
     Ok(())
 }
 

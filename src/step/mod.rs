@@ -73,6 +73,11 @@ pub trait Engine: Send {
     /// The active contacts, as [`Snapshot::contacts`] has them, with their particles' positions
     /// and radii: a sample of the contact stress without a snapshot of every particle.
     fn contact_sample(&self) -> Vec<SampledContact>;
+    /// Takes [`Engine::contact_sample`] inside every later run at each step that is a multiple
+    /// of `every` (0: never), once that step's forces are evaluated, without stopping the run.
+    fn sample_contacts_every(&mut self, every: u64);
+    /// The contact samples taken inside runs since the last call, by step, in step order.
+    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)>;
     /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
     /// carry this law's history ([`Engine::history_words`] words each).
     fn restore(&mut self, snap: &Snapshot);
@@ -128,6 +133,12 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn contact_sample(&self) -> Vec<SampledContact> {
         self.core.contact_sample()
+    }
+    fn sample_contacts_every(&mut self, every: u64) {
+        self.core.params.contact_every = every;
+    }
+    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)> {
+        std::mem::take(&mut self.core.contact_samples)
     }
     fn restore(&mut self, snap: &Snapshot) {
         self.core.restore(snap)
@@ -340,6 +351,7 @@ impl<L: ContactLaw> Simulation<L> {
         let domain = core.state.domain.clone();
         let params = &core.params;
         let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
+        let (contact_every, first_step) = (params.contact_every, core.state.step);
         let guard = params.guard;
         let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
         let periodic_gravity = params
@@ -372,6 +384,8 @@ impl<L: ContactLaw> Simulation<L> {
                 periodic_gravity,
             },
             skin,
+            contact_every,
+            first_step,
         };
         let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
         let done = if threads == 1 {
@@ -392,6 +406,7 @@ impl<L: ContactLaw> Simulation<L> {
                     mine.flows.add(&theirs.flows);
                     mine.deepest = mine.deepest.max(theirs.deepest);
                     mine.pumped = mine.pumped.max(theirs.pumped);
+                    mine.samples.extend(theirs.samples);
                 }
                 mine
             })
@@ -403,6 +418,7 @@ impl<L: ContactLaw> Simulation<L> {
         core.work.moved_bound = done.bound;
         core.deepest = core.deepest.max(done.deepest);
         core.pumped = core.pumped.max(done.pumped);
+        core.contact_samples.extend(done.samples);
         for _ in 0..done.steps {
             core.state.time += dt;
         }
@@ -425,7 +441,7 @@ impl<L: ContactLaw> Simulation<L> {
 /// completed (fewer than asked when the run guard stops the run: every thread stops at the same
 /// meeting), the work supplied in its passes (fixed point), the ledgers' flows of its passes
 /// (all but the work of gravity, which is in `supplied`), the largest overlap and the largest
-/// excess of a contact's energy account it saw.
+/// excess of a contact's energy account it saw, and the contact samples it took.
 struct Done {
     times: StageTimes,
     bound: [f64; 2],
@@ -434,6 +450,7 @@ struct Done {
     flows: Flows,
     deepest: f64,
     pumped: f64,
+    samples: Vec<(u64, Vec<SampledContact>)>,
 }
 
 /// What the threads of a run share.
@@ -459,6 +476,10 @@ struct Team<'a, L: ContactLaw> {
     alarm: Alarm,
     kick: Kick<'a>,
     skin: f64,
+    /// A contact sample at every step that is a multiple of it (0: none).
+    contact_every: u64,
+    /// The step the run starts from.
+    first_step: u64,
 }
 
 /// One thread of a run: its share of every stage, and its own counters.
@@ -481,6 +502,8 @@ struct Worker<'t, 'a, L: ContactLaw> {
     /// Largest excess of a contact's energy account in its pair passes, as a fraction of what
     /// the contact took.
     pumped: f64,
+    /// The contact samples it took (thread 0 only).
+    samples: Vec<(u64, Vec<SampledContact>)>,
 }
 
 impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
@@ -497,6 +520,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             flows: Flows::default(),
             deepest: 0.0,
             pumped: 0.0,
+            samples: Vec::new(),
         }
     }
 
@@ -519,13 +543,14 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                 self.rebuild(s);
             }
             self.pair_forces(s);
+            self.sample_contacts(s);
         }
         self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
         self.done(steps)
     }
 
     /// What this thread leaves after `steps` steps.
-    fn done(&self, steps: u64) -> Done {
+    fn done(&mut self, steps: u64) -> Done {
         Done {
             times: self.times,
             bound: self.bound,
@@ -534,6 +559,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             flows: self.flows,
             deepest: self.deepest,
             pumped: self.pumped,
+            samples: std::mem::take(&mut self.samples),
         }
     }
 
@@ -652,6 +678,42 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         // rebuild.
         self.arr = unsafe { *team.arrays.read() };
         self.laps.lap(&mut self.times.neighbor);
+    }
+
+    /// Thread 0 takes a contact sample of the step that the pair pass of step `s` has just
+    /// evaluated when the run samples it ([`Params::contact_every`]); the team's other threads
+    /// wait meanwhile, so that no position moves under it.
+    fn sample_contacts(&mut self, s: u64) {
+        let team = self.team;
+        let step = team.first_step + s + 1;
+        if team.contact_every == 0 || !step.is_multiple_of(team.contact_every) {
+            return;
+        }
+        if team.threads > 1 {
+            team.barrier.wait();
+        }
+        if self.tid == 0 {
+            let (arr, n, pairs) = (&self.arr, self.arr.x.len(), self.arr.p.len());
+            // SAFETY: every pair chunk of the step is done (each thread finished its pair pass
+            // before the barrier above) and the other threads wait at the barrier below, so
+            // nothing writes these arrays while they are read; the ids change only in a rebuild.
+            let contacts = unsafe {
+                core::contacts_of(
+                    (
+                        arr.x.slice(0..n),
+                        arr.radius.slice(0..n),
+                        team.list.read().id,
+                    ),
+                    (arr.p.slice(0..pairs), arr.i.slice(0..pairs)),
+                    (arr.active.slice(0..pairs), arr.out.slice(0..pairs)),
+                )
+            };
+            self.samples.push((step, contacts));
+        }
+        if team.threads > 1 {
+            team.barrier.wait();
+        }
+        self.laps.lap(&mut self.times.wait);
     }
 
     /// Pair pass of step `s` over the chunks this thread takes, each marked done for the

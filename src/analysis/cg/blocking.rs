@@ -99,6 +99,9 @@ pub enum Method {
     /// than its slow fluctuations comes out too small), or shorter than [`MIN_BLOCKS`] τ.
     /// The error is taken from τ all the same and is not to be trusted.
     TooShort,
+    /// The in-run sampling is not one at which the column's reference τ was calibrated
+    /// ([`Floor::inrun`]): taken as above, and not to be trusted.
+    Uncalibrated,
 }
 
 /// Per column of [`COLUMNS`]: the integrated autocorrelation time (in units) of its series,
@@ -120,6 +123,8 @@ pub struct FieldErrors {
     /// The reference τ of each column's core mean in units (0 where there is none): what
     /// [`core_mean`] takes no τ below.
     pub core_floor: Vec<f64>,
+    /// Whether the references hold for the series ([`Floor::calibrated`]).
+    pub calibrated: Vec<bool>,
 }
 
 /// The reference τ (in units of a series) that errors take no τ below, per column of
@@ -128,6 +133,9 @@ pub struct FieldErrors {
 pub struct Floor {
     pub slice: Vec<f64>,
     pub core: Vec<f64>,
+    /// Whether each column's references hold for the series; an error of a column whose do not
+    /// is not to be trusted ([`Method::Uncalibrated`]).
+    pub calibrated: Vec<bool>,
 }
 
 impl Floor {
@@ -136,6 +144,7 @@ impl Floor {
         Floor {
             slice: vec![0.0; COLUMNS.len()],
             core: vec![0.0; COLUMNS.len()],
+            calibrated: vec![true; COLUMNS.len()],
         }
     }
 
@@ -146,9 +155,79 @@ impl Floor {
         Floor {
             slice: of(&REFERENCE_TAU),
             core: of(&CORE_REFERENCE_TAU),
+            calibrated: vec![true; COLUMNS.len()],
         }
     }
+
+    /// The benchmark's references for in-run bins of `unit_time` with the contact stress
+    /// sampled every `contact_every` and the particle fields every `particle_every` time units:
+    /// those of [`Floor::reference`] at [`DEFAULT_SAMPLING`]; with the contact columns'
+    /// references of [`DENSE_CONTACT_TAU`] at [`DENSE_SAMPLING`]; at any other sampling the
+    /// contact columns' are not calibrated (how much of a bin's variance is the contacts' white
+    /// noise, which sets the τ its error needs, depends on the sampling).
+    pub fn inrun(unit_time: f64, contact_every: f64, particle_every: f64) -> Floor {
+        let mut f = Floor::reference(unit_time);
+        let at = |(k, kp): (u64, u64)| {
+            let near = |steps: u64, t: f64| (steps as f64 * BENCHMARK_DT / t - 1.0).abs() < 1e-3;
+            near(k, contact_every) && near(kp, particle_every)
+        };
+        if at(DEFAULT_SAMPLING) {
+            return f;
+        }
+        let dense = at(DENSE_SAMPLING);
+        for (k, c) in (FIRST_CONTACT_COLUMN..COLUMNS.len()).enumerate() {
+            match DENSE_CONTACT_TAU[k].filter(|_| dense) {
+                Some([slice, core]) => {
+                    f.slice[c] = slice / unit_time;
+                    f.core[c] = core / unit_time;
+                }
+                None => f.calibrated[c] = false,
+            }
+        }
+        f
+    }
 }
+
+/// The benchmark's time step (time units): tc/50 of a free–free contact
+/// (`cases/shear_flow.toml`).
+const BENCHMARK_DT: f64 = 7.192545031528827e-05;
+
+/// The first contact-stress column of [`COLUMNS`] (`con_xx`); the pressure and the shear
+/// stress follow the nine components.
+const FIRST_CONTACT_COLUMN: usize = 15;
+
+/// The in-run sampling the references were calibrated at, (contact interval, particle
+/// interval) in steps of the benchmark's dt: the contact stress every 8 contact durations, the
+/// particle fields (and a bin) every 24, `verdem run`'s default.
+pub const DEFAULT_SAMPLING: (u64, u64) = (400, 1200);
+
+/// A denser sampling, the contact stress every half a contact duration (`--inrun-every 25
+/// --inrun-particle-every 1200`), at which the contact columns' references are
+/// [`DENSE_CONTACT_TAU`].
+pub const DENSE_SAMPLING: (u64, u64) = (25, 1200);
+
+/// The reference τ (time units) of a slice and of the core mean of the contact columns
+/// (con_xx … con_zz, pressure, shear stress) at [`DENSE_SAMPLING`]: the core's is the τ with
+/// which the errors of 60 runs of 144 time units match the spread of their core means (two
+/// chains of 30 from the full runs' final states, each run from the last save of the one
+/// before), the slices' the default's but con_xy's (its slices' errors were 1.4 times too small
+/// without one); validated on 20 more runs (docs/statistics.md, "Sampling the contact stress
+/// every 25 steps"). Sampled this often, a bin's white noise is small and its slower part
+/// rules, so the core's are longer than the default sampling's. `None`: not measured (con_yx,
+/// con_yz, con_zx, con_zy).
+pub const DENSE_CONTACT_TAU: [Option<[f64; 2]>; 11] = [
+    Some([1.0, 0.52]),
+    Some([1.0, 0.12]),
+    Some([0.0, 0.31]),
+    None,
+    Some([1.0, 0.57]),
+    None,
+    None,
+    None,
+    Some([1.0, 0.49]),
+    Some([1.0, 0.84]),
+    Some([0.0, 0.33]),
+];
 
 /// Integrated autocorrelation time, in time units, of each column of [`COLUMNS`] at one slice of
 /// the steady bumpy-shear benchmark, for in-run averaging at its default sampling: the τ with
@@ -257,10 +336,11 @@ pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floors: &Floor) -> F
         .zip(floor)
         .map(|(&m, &f)| floored(m, f))
         .collect();
-    let chosen: Vec<(usize, Method)> = tau
-        .iter()
-        .zip(floor)
-        .map(|(&t, &f)| method(n, t, f))
+    let chosen: Vec<(usize, Method)> = (0..COLUMNS.len())
+        .map(|c| match method(n, tau[c], floor[c]) {
+            (b, _) if !floors.calibrated[c] => (b, Method::Uncalibrated),
+            chosen => chosen,
+        })
         .collect();
     let per_unit: Vec<Vec<Vec<f64>>> = units
         .iter()
@@ -293,6 +373,7 @@ pub fn field_errors_with_floor(units: &[Unit], grid: &Grid, floors: &Floor) -> F
         method: chosen.iter().map(|c| c.1).collect(),
         se,
         core_floor: floors.core.clone(),
+        calibrated: floors.calibrated.clone(),
     }
 }
 
@@ -319,14 +400,26 @@ pub struct CoreMean {
 /// a slice's: a slice's reference ([`REFERENCE_TAU`]) does not enter.
 pub fn core_mean(units: &[Unit], grid: &Grid, errors: &FieldErrors, c: usize) -> CoreMean {
     let (all, series) = core_series(units, grid);
-    core_mean_of(all[c], &series[c], errors.core_floor[c])
+    core_mean_of(
+        all[c],
+        &series[c],
+        errors.core_floor[c],
+        errors.calibrated[c],
+    )
 }
 
 /// Per column of [`COLUMNS`], its core mean over `units` with its error ([`core_mean`]).
 pub fn core_means(units: &[Unit], grid: &Grid, errors: &FieldErrors) -> Vec<CoreMean> {
     let (all, series) = core_series(units, grid);
     (0..COLUMNS.len())
-        .map(|c| core_mean_of(all[c], &series[c], errors.core_floor[c]))
+        .map(|c| {
+            core_mean_of(
+                all[c],
+                &series[c],
+                errors.core_floor[c],
+                errors.calibrated[c],
+            )
+        })
         .collect()
 }
 
@@ -348,8 +441,8 @@ fn core_series(units: &[Unit], grid: &Grid) -> (Vec<f64>, Vec<Vec<f64>>) {
 }
 
 /// [`core_mean`] of one column: its merged core mean `mean`, the series of the units' core
-/// means and the core's reference τ `floor` (units).
-fn core_mean_of(mean: f64, series: &[f64], floor: f64) -> CoreMean {
+/// means, the core's reference τ `floor` (units) and whether it holds for the series.
+fn core_mean_of(mean: f64, series: &[f64], floor: f64, calibrated: bool) -> CoreMean {
     let n = series.len();
     let tau = floored(integrated_autocorrelation(series), floor);
     CoreMean {
@@ -357,7 +450,7 @@ fn core_mean_of(mean: f64, series: &[f64], floor: f64) -> CoreMean {
         se: tau_standard_error(series, tau),
         // n/τ − 1 as for a slice's error from τ ([`degrees_of_freedom`]); τ is at least ½
         dof: (n as f64 / tau.max(0.5) - 1.0).max(1.0),
-        long_enough: method(n, tau, floor).1 != Method::TooShort,
+        long_enough: calibrated && method(n, tau, floor).1 != Method::TooShort,
     }
 }
 
@@ -428,6 +521,9 @@ pub fn describe(errors: &FieldErrors, units: usize, unit: &str) -> String {
                 degrees_of_freedom(errors, c, units)
             ),
             Method::TooShort => ": TOO SHORT, error not to be trusted".into(),
+            Method::Uncalibrated => {
+                ": NOT CALIBRATED at this sampling, error not to be trusted".into()
+            }
         };
         s.push_str(&format!(
             "  {name:9} tau {tau}, {} blocks of {:.1} (needs >= {}){how}\n",
@@ -480,6 +576,7 @@ pub fn errors_csv(errors: &FieldErrors, units: usize, core: &[CoreMean]) -> Stri
                 Method::Blocks => "blocks",
                 Method::Tau => "tau",
                 Method::TooShort => "TOO SHORT",
+                Method::Uncalibrated => "NOT CALIBRATED",
             },
             sci(m.mean),
             sci(m.se),
@@ -545,7 +642,7 @@ mod tests {
         floor[nu] = 49.5;
         let floors = Floor {
             slice: floor,
-            core: vec![0.0; COLUMNS.len()],
+            ..Floor::none()
         };
         let e = field_errors_with_floor(&units, &grid, &floors);
         assert_eq!(e.method[nu], Method::Tau);
@@ -570,6 +667,75 @@ mod tests {
         assert_eq!(cells[10], "false", "{row}");
         // a column without a reference τ keeps its own, and a constant one its blocks of one
         assert_eq!(e.method[COLUMNS.len() - 1], Method::Blocks);
+    }
+
+    /// The contact columns' references hold at the two calibrated in-run samplings only: the
+    /// default's are the tables', the dense one's core references are its own, and at any other
+    /// sampling (or at the dense one for a column it did not measure) the column's errors are
+    /// marked not to be trusted, in the table and in its core mean, while the particle
+    /// columns' stand.
+    #[test]
+    fn contact_references_hold_only_at_the_samplings_they_were_calibrated_at() {
+        let bin = 1200.0 * BENCHMARK_DT;
+        let at = |(k, kp): (u64, u64)| {
+            Floor::inrun(bin, k as f64 * BENCHMARK_DT, kp as f64 * BENCHMARK_DT)
+        };
+        let col = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+        let (p, yx, nu) = (col("pressure"), col("con_yx"), col("nu"));
+        assert_eq!(at(DEFAULT_SAMPLING), Floor::reference(bin));
+        let dense = at(DENSE_SAMPLING);
+        assert!(
+            (dense.core[p] * bin - 0.84).abs() < 1e-12,
+            "{}",
+            dense.core[p]
+        );
+        let xy = col("con_xy");
+        assert!(
+            (dense.slice[xy] * bin - 1.0).abs() < 1e-12,
+            "{}",
+            dense.slice[xy]
+        );
+        assert_eq!(dense.slice[p], Floor::reference(bin).slice[p]);
+        assert!(dense.calibrated[p] && !dense.calibrated[yx] && dense.calibrated[nu]);
+        let other = at((25, 1000));
+        assert!((FIRST_CONTACT_COLUMN..COLUMNS.len()).all(|c| !other.calibrated[c]));
+        assert!((0..FIRST_CONTACT_COLUMN).all(|c| other.calibrated[c]));
+        // 100 bins of white noise in 5 slices (core z in [3, 7] of [0, 10]): the contact
+        // columns are marked, whatever their blocks
+        let grid = Grid {
+            z0: 0.0,
+            z1: 10.0,
+            n: 5,
+        };
+        let noise = ar1(0.0, 100, 7);
+        let units: Vec<Unit> = noise
+            .iter()
+            .map(|x| {
+                let mut raw = Raw::zeros(grid.n);
+                for k in 0..grid.n {
+                    raw.nu[k] = 0.5 + x;
+                    raw.rho[k] = 1.0;
+                    raw.contact[k][(0, 0)] = 1.0 + x;
+                }
+                Unit::of_save(raw)
+            })
+            .collect();
+        let e = field_errors_with_floor(&units, &grid, &other);
+        assert_eq!(e.method[p], Method::Uncalibrated);
+        assert_ne!(e.method[nu], Method::Uncalibrated);
+        let core = core_means(&units, &grid, &e);
+        assert!(!core[p].long_enough);
+        let csv = errors_csv(&e, units.len(), &core);
+        let row = csv.lines().find(|l| l.starts_with("pressure,")).unwrap();
+        assert!(
+            row.contains(",NOT CALIBRATED,") && row.ends_with(",false"),
+            "{row}"
+        );
+        let d = describe(&e, units.len(), "bins");
+        assert_eq!(
+            d.matches("NOT CALIBRATED").count(),
+            COLUMNS.len() - FIRST_CONTACT_COLUMN
+        );
     }
 
     #[test]
