@@ -340,8 +340,14 @@ fn the_cross_loop_averages_in_run_as_the_run_loop_does() {
             verdem::peers::inrun::advance_observed(e.as_mut(), sampling.to, &mut acc).unwrap();
         }
         let r = acc.result().expect("samples");
-        assert_eq!(r.contact_samples, (sampling.to - sampling.from) / sampling.every);
-        [verdem::analysis::inrun::csv(&r), verdem::analysis::inrun::errors_csv(&r)]
+        assert_eq!(
+            r.contact_samples,
+            (sampling.to - sampling.from) / sampling.every
+        );
+        [
+            verdem::analysis::inrun::csv(&r),
+            verdem::analysis::inrun::errors_csv(&r),
+        ]
     };
     assert_eq!(outputs(true), outputs(false));
 }
