@@ -11,6 +11,9 @@
 //! 4. gather: each particle sums its slots in the order of its partners' ids; kick:
 //!    v += (F/m + g)·dt/2, ω += T/I·dt/2; t += dt (a running sum).
 //!
+//! On a step the run samples ([`Params::contact_every`]), thread 0 reads the active contacts
+//! between 3 and 4 while the other threads wait; nothing is written.
+//!
 //! Steps 4 of one step and 1 of the next touch only one particle each, so they run fused in one
 //! pass ([`integrate`]). With T threads every thread runs [`Worker::run`], the stages above by
 //! name; each pass is cut into chunks (contiguous particles, contiguous pairs) that the threads
