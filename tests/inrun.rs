@@ -7,6 +7,7 @@ mod common;
 use verdem::analysis::cg::{self, CgOptions, Series, COLUMNS};
 use verdem::analysis::inrun::{Inrun, Sampling};
 use verdem::analysis::stats::standard_error;
+use verdem::analysis::verdict::Outcome;
 use verdem::case::Case;
 use verdem::engine::Overrides;
 use verdem::run::{self, RunOptions};
@@ -350,4 +351,55 @@ fn the_cross_loop_averages_in_run_as_the_run_loop_does() {
         ]
     };
     assert_eq!(outputs(true), outputs(false));
+}
+
+/// The checks that judge by the contact stress's per-slice errors judge them at a calibrated
+/// sampling and only report them at another (the particle fields' checks stand at both).
+#[test]
+fn checks_by_errors_not_calibrated_at_the_sampling_are_reported_only() {
+    let (case, _) = steady();
+    let verdicts = |particle_every: u64| {
+        let (_, mut e) = steady();
+        let s = Sampling {
+            every: 25,
+            particle_every,
+            from: 6000,
+            to: 30000,
+        };
+        let mut acc = Inrun::new(&CgOptions::for_case(&case), &e.state().domain, s)
+            .unwrap()
+            .with_reference_tau(case.dt());
+        let dir = tempfile::tempdir().unwrap();
+        let opts = options(dir.path(), s.to, 6000, false);
+        run::run_observed(e.as_mut(), &opts, false, Some(&mut acc)).unwrap();
+        let r = acc.result().expect("samples");
+        cg::checks::run(&r.profiles, r.density)
+    };
+    let find = |v: &[cg::checks::Check], q: &str| {
+        v.iter()
+            .find(|c| c.quantity.starts_with(q))
+            .unwrap_or_else(|| panic!("no check {q}"))
+            .clone()
+    };
+    let (calibrated, other) = (verdicts(1200), verdicts(1000));
+    for q in [
+        "shear stress uniform",
+        "sigma_zz uniform",
+        "symmetric pressure",
+    ] {
+        let (a, b) = (find(&calibrated, q), find(&other, q));
+        assert_ne!(
+            a.outcome,
+            Outcome::Reported,
+            "{q} at the calibrated sampling"
+        );
+        assert_eq!(b.outcome, Outcome::Reported, "{q} at another sampling");
+        assert!(
+            b.expected_text.contains("not calibrated"),
+            "{}",
+            b.expected_text
+        );
+    }
+    let nu = find(&other, "symmetric nu");
+    assert_ne!(nu.outcome, Outcome::Reported);
 }

@@ -412,6 +412,7 @@ impl Inrun {
             free_volume: self.free_volume,
             tau_shear: errors.tau[col("shear_xz")],
             tau_energy,
+            trusted: errors.calibrated.clone(),
         };
         let trace_tau = |k: usize| {
             let x: Vec<f64> = self.trace.iter().map(|t| t[k]).collect();

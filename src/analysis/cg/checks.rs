@@ -143,11 +143,23 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
     } else {
         "; not judged: 1 block gives no error bar"
     };
+    // A check by the errors of columns not calibrated at the in-run sampling is reported only.
+    let by_errors_of = |names: &[&str]| -> (bool, &str) {
+        if judged && !names.iter().all(|n| p.trusted[col(n)]) {
+            (
+                false,
+                "; not judged: errors not calibrated at this sampling",
+            )
+        } else {
+            (judged, unjudged)
+        }
+    };
     // 1. Momentum balance: shear stress and σzz uniform across the core.
     let (tau_mean, tau_chi) = {
         let (v, se) = get("shear_xz");
         weighted_mean_chi2(&v, &se)
     };
+    let (judged_by, why) = by_errors_of(&["shear_xz"]);
     out.push(
         Verdict::judge(
             "",
@@ -155,14 +167,14 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             tau_chi,
             Limit::Below(limit),
         )
-        .judged_if(judged)
+        .judged_if(judged_by)
         .described(
             format!(
                 "chi2/dof = {:.2} (mean {:.5})",
                 Shown(tau_chi),
                 Shown(tau_mean)
             ),
-            format!("< {limit}{unjudged}"),
+            format!("< {limit}{why}"),
         ),
     );
     let zz: Vec<f64> = core
@@ -174,6 +186,7 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         .map(|k| (p.se[k][col("kin_zz")].powi(2) + p.se[k][col("con_zz")].powi(2)).sqrt())
         .collect();
     let (zz_mean, zz_chi) = weighted_mean_chi2(&zz, &zz_se);
+    let (judged_by, why) = by_errors_of(&["kin_zz", "con_zz"]);
     out.push(
         Verdict::judge(
             "",
@@ -181,14 +194,14 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
             zz_chi,
             Limit::Below(limit),
         )
-        .judged_if(judged)
+        .judged_if(judged_by)
         .described(
             format!(
                 "chi2/dof = {:.2} (mean {:.5})",
                 Shown(zz_chi),
                 Shown(zz_mean)
             ),
-            format!("< {limit}{unjudged}"),
+            format!("< {limit}{why}"),
         ),
     );
     // 2. Wall consistency: σ·n at each wall equals the wall force per area. Top wall (normal
@@ -330,12 +343,13 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         } else {
             format!("symmetric {name} about the mid-plane")
         };
+        let (judged_by, why) = by_errors_of(&[name]);
         out.push(
             Verdict::judge("", &quantity, m.chi2, Limit::Below(limit))
-                .judged_if(judged)
+                .judged_if(judged_by)
                 .described(
                     format!("chi2/dof = {:.2}{unmeasured_note}", Shown(m.chi2)),
-                    format!("< {limit}{unjudged}"),
+                    format!("< {limit}{why}"),
                 ),
         );
         if drifts {

@@ -219,6 +219,10 @@ pub struct Profiles {
     /// core-averaged kinetic energy density.
     pub tau_shear: f64,
     pub tau_energy: f64,
+    /// Per column of [`columns`]: whether its standard errors can be trusted where a check
+    /// judges by them (false for an in-run sampling its reference τ was not calibrated at,
+    /// [`blocking::Method::Uncalibrated`]).
+    pub trusted: Vec<bool>,
 }
 
 /// The five profiles of the benchmark, as (label, index in [`COLUMNS`]).
@@ -397,6 +401,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         free_volume,
         tau_shear,
         tau_energy,
+        trusted: vec![true; COLUMNS.len()],
     })
 }
 
