@@ -140,9 +140,8 @@ pub fn peer_profiles(
         let file = dir.join(WALLS_FILE);
         book_wall_means(&mut acc, &file, &read_wall_means(&file, sampling.every)?)?;
     }
-    let mut step = sampling.from;
-    while let Some(next) = acc.next_after(step) {
-        step = next;
+    let first = (sampling.from / sampling.every + 1) * sampling.every;
+    for step in (first..=sampling.to).step_by(sampling.every as usize) {
         let particles = step.is_multiple_of(sampling.particle_every);
         let s = peer
             .read_sample(dir, step, template, particles)
