@@ -681,6 +681,13 @@ mod tests {
             Floor::inrun(bin, k as f64 * BENCHMARK_DT, kp as f64 * BENCHMARK_DT)
         };
         let col = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+        // the dense table's rows are the columns from con_xx to the end, in COLUMNS' order
+        assert_eq!(FIRST_CONTACT_COLUMN, col("con_xx"));
+        assert_eq!(
+            COLUMNS.len() - FIRST_CONTACT_COLUMN,
+            DENSE_CONTACT_TAU.len()
+        );
+        assert_eq!(COLUMNS[COLUMNS.len() - 1], "shear_xz");
         let (p, yx, nu) = (col("pressure"), col("con_yx"), col("nu"));
         assert_eq!(at(DEFAULT_SAMPLING), Floor::reference(bin));
         let dense = at(DENSE_SAMPLING);
