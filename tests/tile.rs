@@ -123,3 +123,41 @@ fn a_case_that_is_not_bumpy_shear_is_refused_with_its_file_named() {
         "{err}"
     );
 }
+
+/// A system of more than a chunk's most particles runs in several chunks on one thread, and in
+/// more than the team's 16 on two or three: the tiled state keeps its bits on 1, 2 and 3 threads
+/// across rebuilds (a small skin makes them frequent).
+#[test]
+fn a_system_of_several_chunks_keeps_its_bits_on_one_two_and_three_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    common::verdem_ok([
+        "tile".as_ref(),
+        "cases/shear_flow_steady.toml".as_ref(),
+        "--nx".as_ref(),
+        "5".as_ref(),
+        "--ny".as_ref(),
+        "4".as_ref(),
+        "--out".as_ref(),
+        dir.path().as_os_str(),
+    ]);
+    let case = Case::load(&dir.path().join("shear_flow_steady_5x4.toml")).unwrap();
+    // 69600 particles: three chunks on one thread
+    assert!(20 * 3480 > 2 * verdem::neighbor::rebuild::CHUNK_PARTICLES);
+    let run = |threads| {
+        let mut e = common::engine(
+            &case,
+            None,
+            Overrides {
+                threads: Some(threads),
+                skin: Some(0.02),
+                ..Overrides::default()
+            },
+        );
+        let hash = common::hash_after(e.as_mut(), 400);
+        (hash, e.counters().rebuilds)
+    };
+    let (reference, rebuilds) = run(1);
+    assert!(rebuilds >= 2, "{rebuilds} rebuilds");
+    assert_eq!(run(2).0, reference, "2 threads");
+    assert_eq!(run(3).0, reference, "3 threads");
+}

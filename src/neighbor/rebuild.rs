@@ -31,6 +31,12 @@ pub const CLASSES: usize = 6;
 /// each of its arrays) stays cheap. Measurements: `docs/performance.md`.
 const CHUNKS_PER_THREAD: usize = 8;
 
+/// Most particles in a chunk: a larger system is cut into more chunks than the team's, so that
+/// the pair pass, which sweeps a chunk's positions and radii (32 bytes a particle, 1 MiB at
+/// most) once per class and gap bin, finds them in the core's own cache. Measured in
+/// `docs/performance.md` ("Chunks of at most 32768 particles").
+pub const CHUNK_PARTICLES: usize = 32768;
+
 /// A free particle is fast, at a build, when its speed exceeds this fraction of the fastest
 /// free particle's.
 const SLOW_FRACTION: f64 = 0.1;
@@ -122,6 +128,8 @@ pub struct Flags {
 pub struct Plan {
     /// Threads of the step.
     pub threads: usize,
+    /// Particles at the last build (their number never changes within a run).
+    pub particles: usize,
     /// The particle pass's chunks: ranges of particles of equal cost.
     pub particle_chunks: Vec<(usize, usize)>,
     /// The pair pass's chunks: ranges of pairs of equal count, in build order.
@@ -198,13 +206,15 @@ impl Plan {
         }
     }
 
-    /// Chunks of each pass: one for a team of one.
+    /// Chunks of each pass: one for a team of one, [`CHUNKS_PER_THREAD`] a thread for a larger
+    /// one, and more when a chunk would hold more than [`CHUNK_PARTICLES`] particles.
     pub fn chunks(&self) -> usize {
-        if self.threads == 1 {
+        let team = if self.threads == 1 {
             1
         } else {
             self.threads * CHUNKS_PER_THREAD
-        }
+        };
+        team.max(self.particles.div_ceil(CHUNK_PARTICLES))
     }
 
     /// Starts every pair chunk's live prefixes empty.
@@ -358,6 +368,7 @@ impl<H: History> ListState<'_, H> {
     /// no longer touch ([`Pairs::dropped`]); the new memory order; room for the permutation and
     /// the search, and the views the crew writes them through.
     fn remember_contacts(&mut self, domain: &Domain) {
+        self.plan.particles = self.particles.len();
         let chunks = self.plan.chunks();
         let s = &mut self.plan.scratch;
         let n = self.particles.len();
