@@ -926,13 +926,19 @@ pub fn cost_png(sizes: &[AtSize], path: &Path) -> anyhow::Result<()> {
                 .x_label_area_size(44)
                 .y_label_area_size(64)
                 .build_cartesian_2d(
-                    (nlo / 1.5..nhi * 1.5).log_scale(),
-                    (clo / 1.5..chi * 1.5).log_scale(),
+                    (nlo / 1.5..nhi * 1.5)
+                        .log_scale()
+                        .with_key_points(one_two_five(nlo / 1.5, nhi * 1.5)),
+                    (clo / 1.5..chi * 1.5)
+                        .log_scale()
+                        .with_key_points(one_two_five(clo / 1.5, chi * 1.5)),
                 )?;
             chart
                 .configure_mesh()
                 .x_desc("particles")
                 .y_desc("ns per particle-step")
+                .x_label_formatter(&|v| format!("{v}"))
+                .y_label_formatter(&|v| format!("{v}"))
                 .label_style(("sans-serif", 13))
                 .draw()?;
             for ((label, points), colour) in lines.iter().zip(colours.iter().cycle()) {
@@ -956,6 +962,23 @@ pub fn cost_png(sizes: &[AtSize], path: &Path) -> anyhow::Result<()> {
     let _ = std::fs::remove_file(&tmp);
     crate::io::atomic::write(path, &drawn?)
         .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// The values 1, 2 and 5 times a power of ten in `lo..=hi` (lo > 0): the labelled ticks of a log
+/// axis, which has some in any range wider than a factor 2.5.
+fn one_two_five(lo: f64, hi: f64) -> Vec<f64> {
+    let mut decade = 10f64.powi(lo.log10().floor() as i32);
+    let mut ticks = Vec::new();
+    while decade <= hi {
+        ticks.extend(
+            [1.0, 2.0, 5.0]
+                .map(|m| m * decade)
+                .into_iter()
+                .filter(|v| (lo..=hi).contains(v)),
+        );
+        decade *= 10.0;
+    }
+    ticks
 }
 
 /// The first lines of `bench.md`: what was timed (`steps` steps of `case` from the state file
@@ -985,6 +1008,16 @@ pub fn cpu_model() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_log_axis_is_labelled_at_one_two_and_five_times_powers_of_ten() {
+        assert_eq!(one_two_five(1.4, 60.0), [2.0, 5.0, 10.0, 20.0, 50.0]);
+        assert_eq!(
+            one_two_five(2320.0, 334080.0),
+            [5e3, 1e4, 2e4, 5e4, 1e5, 2e5]
+        );
+        assert_eq!(one_two_five(1.0, 1.9), [1.0]);
+    }
 
     fn measured(threads: usize, copies: usize, rates: &[f64]) -> Measured {
         Measured {
