@@ -867,15 +867,17 @@ pub fn csv(sizes: &[AtSize]) -> String {
     String::from_utf8(w.into_inner().expect(fail)).expect("CSV of UTF-8 fields")
 }
 
+/// One line of the cost plot: its label (code, process count) and its points (particles, ns
+/// per particle-step).
+pub type CostLine = (String, Vec<(f64, f64)>);
+
 /// Draws the cost per particle-step (ns) against the particles, both on log axes, one line per
 /// code and process count (verdem's ceiling rows left out), into the PNG `path`.
 pub fn cost_png(sizes: &[AtSize], path: &Path) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    crate::analysis::cg::plot::register_font()?;
     let Some(first) = sizes.first() else {
         anyhow::bail!("{}: no sizes to plot", path.display());
     };
-    let lines: Vec<(String, Vec<(f64, f64)>)> = (0..first.measured.len())
+    let lines: Vec<CostLine> = (0..first.measured.len())
         .filter(|&k| processes(&first.measured[k].config).is_some())
         .map(|k| {
             let (code, n) = first.measured[k].config.label();
@@ -893,6 +895,74 @@ pub fn cost_png(sizes: &[AtSize], path: &Path) -> anyhow::Result<()> {
             (format!("{code}, {n}"), points)
         })
         .collect();
+    draw_cost(&lines, path)
+}
+
+/// The lines of the cost plot from a sweep's `bench.csv` (columns `code`, `procs`, `particles`
+/// and `ns_per_particle_step`, one row per configuration and size, as [`csv`] writes them), in
+/// the order the rows name them; the ceiling rows (processes `2×1`) are left out, as in
+/// [`cost_png`]. A missing column or a field that is not a positive number is an error that
+/// names the file, the line and the field.
+pub fn cost_lines(path: &Path) -> Result<Vec<CostLine>, crate::io::FormatError> {
+    let (file, text) = crate::io::read_text(path)?;
+    let fail = |line: usize, msg: String| crate::io::FormatError {
+        file: file.clone(),
+        line,
+        msg,
+    };
+    let mut records = crate::io::csv_table::records(&file, &text, false);
+    let Some((_, header)) = records.next().transpose()? else {
+        return Err(fail(0, "empty: no header".into()));
+    };
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| fail(1, format!("no column {name}")))
+    };
+    let (code_at, procs_at) = (column("code")?, column("procs")?);
+    let (n_at, ns_at) = (column("particles")?, column("ns_per_particle_step")?);
+    let mut lines: Vec<CostLine> = Vec::new();
+    for record in records {
+        let (line, row) = record?;
+        let cell = |at: usize| row.get(at).unwrap_or_default();
+        let procs = cell(procs_at);
+        if procs.contains('×') {
+            continue;
+        }
+        let number = |at: usize, name: &str| {
+            cell(at)
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite() && *x > 0.0)
+                .ok_or_else(|| {
+                    fail(
+                        line,
+                        format!("field {name}: not a positive number: {:?}", cell(at)),
+                    )
+                })
+        };
+        number(procs_at, "procs")?;
+        let point = (
+            number(n_at, "particles")?,
+            number(ns_at, "ns_per_particle_step")?,
+        );
+        let label = format!("{}, {procs}", cell(code_at));
+        match lines.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, points)) => points.push(point),
+            None => lines.push((label, vec![point])),
+        }
+    }
+    if lines.is_empty() {
+        return Err(fail(0, "no row to plot".into()));
+    }
+    Ok(lines)
+}
+
+/// Draws `lines` (particles, ns per particle-step) on log axes into the PNG `path`.
+pub fn draw_cost(lines: &[CostLine], path: &Path) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    crate::analysis::cg::plot::register_font()?;
     let all = || lines.iter().flat_map(|(_, p)| p.iter());
     let (nlo, nhi) = all().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
         (lo.min(p.0), hi.max(p.0))
@@ -1008,6 +1078,49 @@ pub fn cpu_model() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cost_lines_group_a_sweeps_rows_by_code_and_processes_and_name_a_bad_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bench.csv");
+        let header = "code,procs,median_steps_per_s,particles,ns_per_particle_step";
+        let rows = [
+            "verdem (deterministic),1,80000,3480,3.6",
+            "verdem (deterministic),2,99000,3480,2.9",
+            "2 independent verdem runs at once (summed),2×1,150000,3480,1.9",
+            "lammps,2,10000,3480,28.3",
+            "verdem (deterministic),1,800,222720,5.6",
+            "verdem (deterministic),2,1500,222720,3.0",
+            "lammps,2,210,222720,21.3",
+        ];
+        std::fs::write(&path, format!("{header}\n{}\n", rows.join("\n"))).unwrap();
+        let lines = cost_lines(&path).unwrap();
+        let expected: Vec<CostLine> = vec![
+            (
+                "verdem (deterministic), 1".into(),
+                vec![(3480.0, 3.6), (222720.0, 5.6)],
+            ),
+            (
+                "verdem (deterministic), 2".into(),
+                vec![(3480.0, 2.9), (222720.0, 3.0)],
+            ),
+            ("lammps, 2".into(), vec![(3480.0, 28.3), (222720.0, 21.3)]),
+        ];
+        assert_eq!(lines, expected);
+        let bad = rows.map(|r| r.replace("lammps,2,210,222720,21.3", "lammps,2,210,222720,"));
+        std::fs::write(&path, format!("{header}\n{}\n", bad.join("\n"))).unwrap();
+        let e = cost_lines(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("bench.csv:8: field ns_per_particle_step: not a positive number: \"\""),
+            "{e}"
+        );
+        std::fs::write(&path, "code,procs,particles\nlammps,1,3480\n").unwrap();
+        let e = cost_lines(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("bench.csv:1: no column ns_per_particle_step"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn a_log_axis_is_labelled_at_one_two_and_five_times_powers_of_ten() {

@@ -119,6 +119,15 @@ fn a_sweep_of_verdem_alone_writes_every_size_with_memory_and_the_plot() {
     for (small, large) in [(0, 2), (1, 3)] {
         assert!(total(large) > total(small) + 1e6, "{rows:?}");
     }
+    // the plot drawn again from the table alone, beside it
+    let png = dir.path().join("bench.png");
+    std::fs::remove_file(&png).unwrap();
+    let csv = dir.path().join("bench.csv");
+    let printed = common::verdem_ok([OsStr::new("bench"), OsStr::new("--plot"), csv.as_os_str()]);
+    let said = String::from_utf8_lossy(&printed.stdout);
+    assert_eq!(said.trim(), format!("plot: {}", png.display()));
+    let png = png::Decoder::new(std::fs::File::open(png).unwrap());
+    assert_eq!(png.read_info().unwrap().info().size(), (900, 600));
 }
 
 #[test]

@@ -65,6 +65,10 @@ pub struct Args {
     /// go.
     #[arg(long, default_value = "out/bench")]
     out: PathBuf,
+    /// Draw a sweep's cost plot again from its `bench.csv` (a recorded sweep's, say), into the
+    /// PNG of the same name beside it, and time nothing.
+    #[arg(long, value_name = "BENCH_CSV", conflicts_with_all = ["scale", "probe"])]
+    plot: Option<PathBuf>,
     /// Run one configuration (`verdem:THREADS` or `PEER:NP`) once and print its peak resident
     /// memory: the child process a sweep measures memory with.
     #[arg(long, hide = true)]
@@ -72,6 +76,12 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
+    if let Some(csv) = &a.plot {
+        let png = csv.with_extension("png");
+        bench::draw_cost(&bench::cost_lines(csv)?, &png)?;
+        println!("plot: {}", png.display());
+        return Ok(Finished::Done);
+    }
     let case_path = a
         .case
         .clone()
