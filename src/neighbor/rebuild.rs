@@ -128,8 +128,6 @@ pub struct Flags {
 pub struct Plan {
     /// Threads of the step.
     pub threads: usize,
-    /// Particles at the last build (their number never changes within a run).
-    pub particles: usize,
     /// The particle pass's chunks: ranges of particles of equal cost.
     pub particle_chunks: Vec<(usize, usize)>,
     /// The pair pass's chunks: ranges of pairs of equal count, in build order.
@@ -206,15 +204,16 @@ impl Plan {
         }
     }
 
-    /// Chunks of each pass: one for a team of one, [`CHUNKS_PER_THREAD`] a thread for a larger
-    /// one, and more when a chunk would hold more than [`CHUNK_PARTICLES`] particles.
-    pub fn chunks(&self) -> usize {
+    /// Chunks of each pass over `particles` particles: one for a team of one,
+    /// [`CHUNKS_PER_THREAD`] a thread for a larger one, and more when a chunk would hold more
+    /// than [`CHUNK_PARTICLES`] particles.
+    pub fn chunks(&self, particles: usize) -> usize {
         let team = if self.threads == 1 {
             1
         } else {
             self.threads * CHUNKS_PER_THREAD
         };
-        team.max(self.particles.div_ceil(CHUNK_PARTICLES))
+        team.max(particles.div_ceil(CHUNK_PARTICLES))
     }
 
     /// Starts every pair chunk's live prefixes empty.
@@ -307,7 +306,8 @@ pub unsafe fn rebuild<H: History>(
     crew.sync();
     let (n, chunks) = {
         let l = list.read();
-        (l.particles.len(), l.plan.chunks())
+        let n = l.particles.len();
+        (n, l.plan.chunks(n))
     };
     crew.share(chunks, |part| {
         // SAFETY: parallel phase: the particles are only read; each chunk writes its own range
@@ -368,8 +368,7 @@ impl<H: History> ListState<'_, H> {
     /// no longer touch ([`Pairs::dropped`]); the new memory order; room for the permutation and
     /// the search, and the views the crew writes them through.
     fn remember_contacts(&mut self, domain: &Domain) {
-        self.plan.particles = self.particles.len();
-        let chunks = self.plan.chunks();
+        let chunks = self.plan.chunks(self.particles.len());
         let s = &mut self.plan.scratch;
         let n = self.particles.len();
         s.old_keys.clear();
@@ -431,7 +430,7 @@ impl<H: History> ListState<'_, H> {
     /// classes, the chunks of both passes, room for the pairs' new order and history, and the
     /// views the crew sorts the pair chunks through.
     fn plan_chunks(&mut self, domain: &Domain) {
-        let chunks = self.plan.chunks();
+        let chunks = self.plan.chunks(self.particles.len());
         let plan = &mut *self.plan;
         let s = &mut plan.scratch;
         let list = &mut self.pairs.list;

@@ -347,7 +347,7 @@ impl<L: ContactLaw> Simulation<L> {
             return 0;
         }
         let threads = core.params.threads;
-        let chunks = core.work.plan.chunks();
+        let chunks = core.work.plan.chunks(core.state.particles.len());
         let bound = core.work.moved_bound;
         let skin = core.work.builder.skin;
         core.work.plan.reset_live();
