@@ -31,21 +31,30 @@ fn set_up(case: &Case) -> Snapshot {
     e.snapshot()
 }
 
-#[test]
-fn a_tiled_state_repeats_every_contact_of_the_cell_once_per_tile() {
-    let dir = tempfile::tempdir().unwrap();
+/// `verdem tile` of the steady case `nx` × `ny` into `dir`: what it printed, and the tiled case.
+fn tile_steady(dir: &std::path::Path, nx: usize, ny: usize) -> (String, std::path::PathBuf) {
+    let (nx_arg, ny_arg) = (nx.to_string(), ny.to_string());
     let out = common::verdem_ok([
         "tile".as_ref(),
         "cases/shear_flow_steady.toml".as_ref(),
         "--nx".as_ref(),
-        "3".as_ref(),
+        nx_arg.as_ref(),
         "--ny".as_ref(),
-        "2".as_ref(),
+        ny_arg.as_ref(),
         "--out".as_ref(),
-        dir.path().as_os_str(),
+        dir.as_os_str(),
     ]);
-    let listed = String::from_utf8_lossy(&out.stdout).to_string();
-    let case_path = dir.path().join("shear_flow_steady_3x2.toml");
+    let printed = String::from_utf8_lossy(&out.stdout).to_string();
+    (
+        printed,
+        dir.join(format!("shear_flow_steady_{nx}x{ny}.toml")),
+    )
+}
+
+#[test]
+fn a_tiled_state_repeats_every_contact_of_the_cell_once_per_tile() {
+    let dir = tempfile::tempdir().unwrap();
+    let (listed, case_path) = tile_steady(dir.path(), 3, 2);
     assert!(listed.contains("shear_flow_steady_3x2.toml"), "{listed}");
     assert!(listed.contains("shear_flow_steady_3x2.data"), "{listed}");
 
@@ -130,17 +139,7 @@ fn a_case_that_is_not_bumpy_shear_is_refused_with_its_file_named() {
 #[test]
 fn a_system_of_several_chunks_keeps_its_bits_on_one_two_and_three_threads() {
     let dir = tempfile::tempdir().unwrap();
-    common::verdem_ok([
-        "tile".as_ref(),
-        "cases/shear_flow_steady.toml".as_ref(),
-        "--nx".as_ref(),
-        "5".as_ref(),
-        "--ny".as_ref(),
-        "4".as_ref(),
-        "--out".as_ref(),
-        dir.path().as_os_str(),
-    ]);
-    let case = Case::load(&dir.path().join("shear_flow_steady_5x4.toml")).unwrap();
+    let case = Case::load(&tile_steady(dir.path(), 5, 4).1).unwrap();
     let run = |threads| {
         let mut e = common::engine(
             &case,
