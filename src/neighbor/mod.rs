@@ -30,6 +30,17 @@ pub struct PairList {
     by_partner: Vec<(u32, u32)>,
 }
 
+/// The cells `lo..hi` of a half stencil; `wraps` when the separation of a particle of the
+/// stencil's cell from one of these may need its minimum image: one of them is reached across a
+/// periodic face, or a periodic axis has too few cells for two neighbours to be surely within
+/// half a period.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    lo: u32,
+    hi: u32,
+    wraps: bool,
+}
+
 /// Builder of pair lists; keeps its scratch buffers between builds.
 #[derive(Clone, Debug)]
 pub struct NeighborBuilder {
@@ -44,12 +55,11 @@ pub struct NeighborBuilder {
     /// Scratch of the counting sort: the memory index of each id, and each cell's next slot.
     by_id: Vec<u32>,
     fill: Vec<u32>,
-    /// Half stencils of the grid they were made for, as runs of consecutive cells: the cells
-    /// `stencil[j].0..stencil[j].1` for `j` in `stencil_start[c]..stencil_start[c + 1]` are
-    /// the distinct cells adjacent to (or equal to) cell `c`, less the runs that lie wholly
-    /// below `c`, in increasing order. The grid depends on the box alone, so they are made
-    /// once.
-    stencil: Vec<(u32, u32)>,
+    /// Half stencils of the grid they were made for, as runs of consecutive cells: the runs
+    /// `stencil[j]` for `j` in `stencil_start[c]..stencil_start[c + 1]` hold the distinct cells
+    /// adjacent to (or equal to) cell `c`, less the runs that lie wholly below `c`, in
+    /// increasing order. The grid depends on the box alone, so they are made once.
+    stencil: Vec<Run>,
     stencil_start: Vec<u32>,
     stencil_grid: Option<([usize; 3], [usize; 3], [bool; 3])>,
 }
@@ -164,20 +174,29 @@ impl NeighborBuilder {
     ) {
         let (found_p, found_i) = found;
         let skin = self.skin;
-        let mut consider = |a: usize, b: usize| {
-            let cut = radius[a] + radius[b] + skin;
-            if interacts(a, b) && domain.min_image(x[a] - x[b]).norm_squared() < cut * cut {
-                let (p, i) = if id[a] < id[b] { (a, b) } else { (b, a) };
-                found_p.push(p as u32);
-                found_i.push(i as u32);
+        // Particle `a` against the particles `from..to`: a pair enters when
+        // |x_a − x_b| < r_a + r_b + skin (the minimum image with `wraps`; without, the direct
+        // separation is its own minimum image, bit for bit) and `interacts(a, b)`.
+        let mut scan = |a: usize, from: usize, to: usize, wraps: bool| {
+            let (xa, ra) = (x[a], radius[a]);
+            for (b, (xb, rb)) in (from..to).zip(x[from..to].iter().zip(&radius[from..to])) {
+                let cut = ra + rb + skin;
+                let d = if wraps {
+                    domain.min_image(xa - xb)
+                } else {
+                    xa - xb
+                };
+                if d.norm_squared() < cut * cut && interacts(a, b) {
+                    let (p, i) = if id[a] < id[b] { (a, b) } else { (b, a) };
+                    found_p.push(p as u32);
+                    found_i.push(i as u32);
+                }
             }
         };
         match self.search {
             Search::AllPairs => {
                 for a in owners {
-                    for b in a + 1..x.len() {
-                        consider(a, b);
-                    }
+                    scan(a, a + 1, x.len(), true);
                 }
             }
             Search::Cells => {
@@ -195,14 +214,12 @@ impl NeighborBuilder {
                     // Cells in index order hold increasing memory indices: each particle's
                     // partners come out sorted (and those in cells below c are lower).
                     for a in s.max(owners.start)..e.min(owners.end) {
-                        for &(lo, hi) in near {
+                        for run in near {
                             let (s, e) = (
-                                self.cell_start[lo as usize] as usize,
-                                self.cell_start[hi as usize] as usize,
+                                self.cell_start[run.lo as usize] as usize,
+                                self.cell_start[run.hi as usize] as usize,
                             );
-                            for b in s.max(a + 1)..e {
-                                consider(a, b);
-                            }
+                            scan(a, s.max(a + 1), e, run.wraps);
                         }
                     }
                 }
@@ -221,19 +238,28 @@ impl NeighborBuilder {
         let mut near = Vec::with_capacity(27);
         for c in 0..grid.count() {
             near.clear();
-            grid.for_each_neighbour(grid.cell_coords(c), |nc| near.push(nc as u32));
+            grid.for_each_neighbour(grid.cell_coords(c), |nc, wraps| {
+                near.push((nc as u32, wraps))
+            });
             near.sort_unstable();
             // Cells adjacent along the fastest axis have consecutive indices: one run each.
             let start = self.stencil.len();
-            for &nc in &near {
+            for &(nc, wraps) in &near {
                 match self.stencil[start..].last_mut() {
-                    Some(run) if run.1 == nc => run.1 = nc + 1,
-                    _ => self.stencil.push((nc, nc + 1)),
+                    Some(run) if run.hi == nc => {
+                        run.hi = nc + 1;
+                        run.wraps |= wraps;
+                    }
+                    _ => self.stencil.push(Run {
+                        lo: nc,
+                        hi: nc + 1,
+                        wraps,
+                    }),
                 }
             }
             let mut kept = start;
             for j in start..self.stencil.len() {
-                if self.stencil[j].1 as usize > c {
+                if self.stencil[j].hi as usize > c {
                     self.stencil[kept] = self.stencil[j];
                     kept += 1;
                 }
@@ -358,31 +384,38 @@ impl Grid {
         (c[a] * self.n[b] + c[b]) * self.n[d] + c[d]
     }
 
-    /// Calls `f` once for each distinct cell adjacent to (or equal to) cell `c`.
-    fn for_each_neighbour(&self, c: [usize; 3], mut f: impl FnMut(usize)) {
-        let mut axis = [[0usize; 3]; 3];
+    /// Calls `f` once for each distinct cell adjacent to (or equal to) cell `c`, with whether
+    /// a separation between the two cells may need its minimum image: the cell is reached
+    /// across a periodic face, or a periodic axis has fewer than 5 cells. With 5 or more, two
+    /// particles in cells adjacent without a wrap are at most 2/5 of the period apart along
+    /// that axis (a particle wrapped onto the box's far face lies within round-off of its cell),
+    /// so `Domain::min_image` shifts nothing.
+    fn for_each_neighbour(&self, c: [usize; 3], mut f: impl FnMut(usize, bool)) {
+        let mut axis = [[(0usize, false); 3]; 3];
         let mut len = [0usize; 3];
         for k in 0..3 {
             let m = self.n[k] as i64;
             for d in -1i64..=1 {
                 let v = c[k] as i64 + d;
+                let outside = v < 0 || v >= m;
                 let v = if self.periodic[k] {
                     v.rem_euclid(m)
-                } else if v < 0 || v >= m {
+                } else if outside {
                     continue;
                 } else {
                     v
                 } as usize;
-                if !axis[k][..len[k]].contains(&v) {
-                    axis[k][len[k]] = v;
+                let wraps = self.periodic[k] && (outside || m < 5);
+                if !axis[k][..len[k]].iter().any(|&(u, _)| u == v) {
+                    axis[k][len[k]] = (v, wraps);
                     len[k] += 1;
                 }
             }
         }
-        for &cx in &axis[0][..len[0]] {
-            for &cy in &axis[1][..len[1]] {
-                for &cz in &axis[2][..len[2]] {
-                    f(self.index([cx, cy, cz]));
+        for &(cx, wx) in &axis[0][..len[0]] {
+            for &(cy, wy) in &axis[1][..len[1]] {
+                for &(cz, wz) in &axis[2][..len[2]] {
+                    f(self.index([cx, cy, cz]), wx || wy || wz);
                 }
             }
         }
