@@ -633,5 +633,27 @@ impl<H: History> ListState<'_, H> {
         self.out = SharedSlice::default();
         self.tally = SharedSlice::default();
         plan.reset_live();
+        self.make_room_for_next_build();
+    }
+
+    /// Room for the next rebuild's carried slots and contact keys, written once now so that
+    /// their pages are in memory: the first rebuild of a run then costs what the later ones do,
+    /// instead of faulting in tens of megabytes at 10⁵ spheres inside the stepping (a one-time
+    /// set-up cost, like a peer's neighbour-list allocation before its time loop). Grows
+    /// only, and appends only: the carried slots of the contacts this build dropped stay valid.
+    fn make_room_for_next_build(&mut self) {
+        let pairs = &mut *self.pairs;
+        let n = pairs.history.len();
+        if pairs.carried.len() < n {
+            pairs.carried.resize(n, H::default());
+            pairs.carried_out.resize(n, PairForce::default());
+            pairs.carried_tally.resize(n, Tally::default());
+        }
+        let keys = &mut self.plan.scratch.old_keys;
+        if keys.capacity() < n {
+            keys.clear();
+            keys.resize(n, (0, 0));
+            keys.clear();
+        }
     }
 }
