@@ -178,7 +178,7 @@ impl NeighborBuilder {
         // |x_a − x_b| < r_a + r_b + skin (the minimum image with `wraps`; without, the direct
         // separation is its own minimum image, bit for bit) and `interacts(a, b)`.
         let mut scan = |a: usize, from: usize, to: usize, wraps: bool| {
-            let (xa, ra) = (x[a], radius[a]);
+            let (xa, ra, to) = (x[a], radius[a], to.max(from));
             for (b, (xb, rb)) in (from..to).zip(x[from..to].iter().zip(&radius[from..to])) {
                 let cut = ra + rb + skin;
                 let d = if wraps {
