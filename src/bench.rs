@@ -531,22 +531,24 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
             .collect()
     };
     let n_far = far.iter().filter(|&&f| f).count();
+    let rounds = team.rates.len();
     line.push_str(&format!(
-        "{n_far} of {} rounds ran with the two CPUs placed far apart (a probe above {threshold:.0} ns, the middle of the widest gap between the bench's probes): verdem 2 threads {} steps/s in those against {} in the others; the ratios above include them\n",
-        team.rates.len(),
-        rate_or_none(&rates(true)),
-        rate_or_none(&rates(false))
+        "{n_far} of {rounds} rounds ran with the two CPUs placed far apart (a probe above {threshold:.0} ns, the middle of the widest gap between the bench's probes)"
     ));
-    Some(line)
-}
-
-/// The median of `rates` as steps/s, or "none".
-fn rate_or_none(rates: &[f64]) -> String {
-    if rates.is_empty() {
-        String::from("none")
+    // The rates of the two groups side by side only when each has a round; otherwise the far
+    // probes came from other configurations' rounds, or every round of the team was far.
+    if n_far == 0 {
+        line.push_str(", the far probes all around other configurations' rounds\n");
+    } else if n_far == rounds {
+        line.push_str(": every ratio above is of that placement\n");
     } else {
-        format!("{:.0}", median(rates))
+        line.push_str(&format!(
+            ": verdem 2 threads {:.0} steps/s in those against {:.0} in the others; the ratios above include them\n",
+            median(&rates(true)),
+            median(&rates(false))
+        ));
     }
+    Some(line)
 }
 
 /// One system size of a sweep: a (tiled) case, its state, and the steps each run takes there.
@@ -1178,8 +1180,28 @@ mod tests {
         assert!(line.contains("1 of 3 rounds"), "{line}");
         // two far rounds
         two.round_trips = vec![[330.0, 340.0], [65.0, 300.0], [90.0, 110.0]];
-        let line = placement(&[one.clone(), two.clone(), pair], &two).unwrap();
+        let line = placement(&[one.clone(), two.clone(), pair.clone()], &two).unwrap();
         assert!(line.contains("2 of 3 rounds"), "{line}");
+        // far probes only in another configuration's rounds, or in every round of the team
+        let mut far_pair = pair.clone();
+        far_pair.round_trips = vec![[450.0, 470.0]; 3];
+        two.round_trips = vec![[60.0, 70.0], [65.0, 80.0], [90.0, 110.0]];
+        let line = placement(&[two.clone(), far_pair.clone()], &two).unwrap();
+        assert!(
+            line.contains("0 of 3 rounds ran with the two CPUs placed far apart")
+                && line.contains("the far probes all around other configurations' rounds")
+                && !line.contains("steps/s"),
+            "{line}"
+        );
+        let mut near_pair = pair.clone();
+        near_pair.round_trips = vec![[60.0, 65.0]; 3];
+        two.round_trips = vec![[450.0, 470.0]; 3];
+        let line = placement(&[two.clone(), near_pair], &two).unwrap();
+        assert!(
+            line.contains("3 of 3 rounds")
+                && line.contains("every ratio above is of that placement"),
+            "{line}"
+        );
         // one placement only, or no probes
         two.round_trips = vec![[60.0, 70.0], [80.0, 95.0], [66.0, 61.0]];
         assert!(placement(&[two.clone()], &two)
