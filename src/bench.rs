@@ -485,8 +485,8 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
 
 /// What the core-to-core probes say of the rounds of `team` (verdem's 2 threads): the median
 /// round trip, and which rounds ran with the two CPUs far apart (a probe before or after the
-/// run above [`far_threshold`] of all the probes of `m`) with the team's median rate in those
-/// rounds and in the others. `None` without probes.
+/// run above [`far_threshold`] of all the probes of `m`), with the team's median rate in those
+/// rounds and in the others when both kinds ran. `None` without probes.
 fn placement(m: &[Measured], team: &Measured) -> Option<String> {
     let all: Vec<f64> = m
         .iter()
@@ -1186,7 +1186,7 @@ mod tests {
         let mut far_pair = pair.clone();
         far_pair.round_trips = vec![[450.0, 470.0]; 3];
         two.round_trips = vec![[60.0, 70.0], [65.0, 80.0], [90.0, 110.0]];
-        let line = placement(&[two.clone(), far_pair.clone()], &two).unwrap();
+        let line = placement(&[two.clone(), far_pair], &two).unwrap();
         assert!(
             line.contains("0 of 3 rounds ran with the two CPUs placed far apart")
                 && line.contains("the far probes all around other configurations' rounds")
