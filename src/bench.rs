@@ -78,11 +78,11 @@ const PROBE_TRIPS: u64 = 20_000;
 /// (2026-11-24 to 11-29) the probes fell at 28–32, 51–151 and 300–500 ns; the two nearest
 /// placements were 1.76× apart at their closest, while consecutive probes within one placement
 /// were never more than 1.3× apart.
-const FAR: f64 = 1.5;
+const PLACEMENT_GAP: f64 = 1.5;
 
 /// The placements of the two CPUs that the probes `probes` (ns) show: the probes sorted and cut
-/// at every gap of more than [`FAR`]×, each group as its lowest and highest probe, nearest
-/// first; empty without probes.
+/// at every gap of more than [`PLACEMENT_GAP`]×, each group as its lowest and highest probe,
+/// nearest first; empty without probes.
 fn placements(probes: &[f64]) -> Vec<(f64, f64)> {
     let mut p: Vec<f64> = probes
         .iter()
@@ -93,7 +93,7 @@ fn placements(probes: &[f64]) -> Vec<(f64, f64)> {
     let mut groups: Vec<(f64, f64)> = Vec::new();
     for x in p {
         match groups.last_mut() {
-            Some((_, hi)) if x / *hi <= FAR => *hi = x,
+            Some((_, hi)) if x / *hi <= PLACEMENT_GAP => *hi = x,
             _ => groups.push((x, x)),
         }
     }
@@ -565,7 +565,7 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
     let groups = placements(&all);
     if groups.len() < 2 {
         line.push_str(&format!(
-            "the bench's probes show one placement of the two CPUs (no gap between them over {FAR}×)\n"
+            "the bench's probes show one placement of the two CPUs (no gap between them over {PLACEMENT_GAP}×)\n"
         ));
         return Some(line);
     }
@@ -593,7 +593,7 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
         })
         .collect();
     line.push_str(&format!(
-        "the bench's probes show {} placements of the two CPUs (cut at every gap over {FAR}×); verdem's 2-thread rounds by the placement of both their probes: {}",
+        "the bench's probes show {} placements of the two CPUs (cut at every gap over {PLACEMENT_GAP}×); verdem's 2-thread rounds by the placement of both their probes: {}",
         groups.len(),
         each.join("; ")
     ));
