@@ -384,14 +384,31 @@ fn limit_verdict(quantity: &str, r: &[f64], limit: Limit, expected: String) -> V
     .described(interval(found), expected)
 }
 
-/// A goal's verdict in words: "met", "not met" or "undecided", followed by the interval.
-fn in_words(v: &Verdict) -> String {
-    let word = match v.outcome {
+/// A goal's verdict in a word or two: "met", "not met" or "undecided".
+fn outcome_word(v: &Verdict) -> &'static str {
+    match v.outcome {
         Outcome::Pass => "met",
         Outcome::Fail => "not met",
         Outcome::Undecided | Outcome::Reported => "undecided",
-    };
-    format!("{word} ({})", v.measured_text)
+    }
+}
+
+/// A goal's verdict in words ([`outcome_word`]), followed by the interval.
+fn in_words(v: &Verdict) -> String {
+    format!("{} ({})", outcome_word(v), v.measured_text)
+}
+
+/// verdem's configuration of `copies` runs of `threads` threads each (`lockstep`: meeting once
+/// a step) among `m`.
+fn verdem_row(m: &[Measured], threads: usize, copies: usize, lockstep: bool) -> Option<&Measured> {
+    m.iter().find(|x| {
+        x.config
+            == Config::Verdem {
+                threads,
+                copies,
+                lockstep,
+            }
+    })
 }
 
 /// The table as markdown: code, processes/threads, steps/s (median and all rounds),
@@ -414,17 +431,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             best / x.median()
         ));
     }
-    let find = |threads: usize, copies: usize, lockstep: bool| {
-        m.iter().find(|x| {
-            x.config
-                == Config::Verdem {
-                    threads,
-                    copies,
-                    lockstep,
-                }
-        })
-    };
-    if let (Some(one), Some(two)) = (find(1, 1, false), find(2, 1, false)) {
+    if let (Some(one), Some(two)) = (verdem_row(m, 1, 1, false), verdem_row(m, 2, 1, false)) {
         let ratios = paired_ratios(one, two);
         let speedup = median(&ratios);
         let (lo, hi) = hinges(&ratios);
@@ -448,7 +455,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
                 100.0 * speedup / ceiling
             )
         };
-        if let Some(pair) = find(1, 2, false) {
+        if let Some(pair) = verdem_row(m, 1, 2, false) {
             s.push_str(&ceiling(
                 pair,
                 "2 independent 1-thread runs at once",
@@ -463,7 +470,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
                 ));
             }
         }
-        if let Some(coupled) = find(1, 2, true) {
+        if let Some(coupled) = verdem_row(m, 1, 2, true) {
             s.push_str(&ceiling(
                 coupled,
                 "the same two runs waiting for each other once a step",
@@ -482,7 +489,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
         }
         s.push('\n');
     }
-    if let Some(two) = find(2, 1, false) {
+    if let Some(two) = verdem_row(m, 2, 1, false) {
         for peer in m
             .iter()
             .filter(|x| matches!(x.config, Config::Peer { np: 2, .. }))
@@ -491,10 +498,9 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             let quantity = format!("verdem 2 threads / {} 2 ranks", peer.config.label().0);
             let verdict = goal_verdict(&quantity, &ratios, PEER_GOAL);
             let goals = if particles == BENCHMARK_PARTICLES {
-                let word = in_words(&verdict);
-                let word = word.split(" (").next().unwrap_or_default();
                 format!(
-                    "{word}, ≥ {BENCHMARK_PEER_GOAL} on the benchmark's cell: {}",
+                    "{}, ≥ {BENCHMARK_PEER_GOAL} on the benchmark's cell: {}",
+                    outcome_word(&verdict),
                     in_words(&goal_verdict(&quantity, &ratios, BENCHMARK_PEER_GOAL))
                 )
             } else {
@@ -506,7 +512,7 @@ pub fn markdown(m: &[Measured], particles: usize) -> String {
             ));
         }
     }
-    if let Some(line) = find(2, 1, false).and_then(|two| placement(m, two)) {
+    if let Some(line) = verdem_row(m, 2, 1, false).and_then(|two| placement(m, two)) {
         s.push_str(&line);
     }
     for x in m {
@@ -616,17 +622,7 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
         return Some(line);
     }
     line.push_str("; the ratios above include every round");
-    let find = |copies: usize, lockstep: bool| {
-        m.iter().find(|x| {
-            x.config
-                == Config::Verdem {
-                    threads: 1,
-                    copies,
-                    lockstep,
-                }
-        })
-    };
-    if let Some(one) = find(1, false) {
+    if let Some(one) = verdem_row(m, 1, 1, false) {
         let (a, b) = groups[common];
         let of = |x: &Measured, rounds: &[usize]| -> Vec<f64> {
             rounds
@@ -641,7 +637,7 @@ fn placement(m: &[Measured], team: &Measured) -> Option<String> {
             median(&speedup),
             interval(median_interval(&speedup, CONFIDENCE))
         ));
-        if let Some(pair) = find(2, true) {
+        if let Some(pair) = verdem_row(m, 1, 2, true) {
             let both: Vec<usize> = rounds
                 .iter()
                 .copied()
@@ -779,18 +775,6 @@ const SCALE_SPEEDUP_FROM: usize = 55_680;
 /// costliest size's over the cheapest's).
 const SPREAD_GOAL: f64 = 1.5;
 
-/// Verdem's configuration of `threads` threads (one copy) among `m`.
-fn verdem_of(m: &[Measured], threads: usize) -> Option<&Measured> {
-    m.iter().find(|x| {
-        x.config
-            == Config::Verdem {
-                threads,
-                copies: 1,
-                lockstep: false,
-            }
-    })
-}
-
 /// The fastest (highest median) of the configurations of `m` that `keep` selects.
 fn fastest(m: &[Measured], keep: impl Fn(&Config) -> bool) -> Option<&Measured> {
     m.iter()
@@ -869,7 +853,7 @@ pub fn sweep_markdown(sizes: &[AtSize]) -> String {
         for t in threads {
             let rows: Vec<(&Measured, usize)> = sizes
                 .iter()
-                .filter_map(|at| verdem_of(&at.measured, t).map(|m| (m, at.particles)))
+                .filter_map(|at| verdem_row(&at.measured, t, 1, false).map(|m| (m, at.particles)))
                 .collect();
             let rounds = rows.iter().map(|(m, _)| m.rates.len()).min().unwrap_or(0);
             let spread: Vec<f64> = (0..rounds)
@@ -900,7 +884,10 @@ pub fn sweep_markdown(sizes: &[AtSize]) -> String {
         }
     }
     for at in sizes.iter().filter(|at| at.particles >= SCALE_SPEEDUP_FROM) {
-        if let (Some(one), Some(two)) = (verdem_of(&at.measured, 1), verdem_of(&at.measured, 2)) {
+        if let (Some(one), Some(two)) = (
+            verdem_row(&at.measured, 1, 1, false),
+            verdem_row(&at.measured, 2, 1, false),
+        ) {
             let quantity = format!("{} particles: verdem 2 threads / 1 thread", at.particles);
             let verdict = goal_verdict(&quantity, &paired_ratios(one, two), SCALE_SPEEDUP_GOAL);
             s.push_str(&format!(
@@ -911,15 +898,7 @@ pub fn sweep_markdown(sizes: &[AtSize]) -> String {
             // What the machine gives two jobs of this size that share nothing, when the ceiling
             // rows ran: a 2-thread code exceeds it only by what halving each core's working set
             // saves, much at sizes beyond a core's cache, little below.
-            let independent = at.measured.iter().find(|x| {
-                x.config
-                    == Config::Verdem {
-                        threads: 1,
-                        copies: 2,
-                        lockstep: false,
-                    }
-            });
-            if let Some(pair) = independent {
+            if let Some(pair) = verdem_row(&at.measured, 1, 2, false) {
                 let ceiling = goal_verdict("", &paired_ratios(one, pair), SCALE_SPEEDUP_GOAL);
                 s.push_str(&format!(
                     "; two independent 1-thread runs at once / 1 run alone, what this machine gives two jobs of this size that share nothing (a split that halves each core's working set can exceed it): {:.2}, ≥ {SCALE_SPEEDUP_GOAL} {}",
@@ -970,7 +949,10 @@ pub fn csv(sizes: &[AtSize]) -> String {
             matches!(c, Config::Verdem { copies: 1, .. })
         })
         .map_or(f64::NAN, Measured::median);
-        let two_over_one = match (verdem_of(&at.measured, 1), verdem_of(&at.measured, 2)) {
+        let two_over_one = match (
+            verdem_row(&at.measured, 1, 1, false),
+            verdem_row(&at.measured, 2, 1, false),
+        ) {
             (Some(one), Some(two)) => format!("{:.3}", median(&paired_ratios(one, two))),
             _ => String::new(),
         };
