@@ -281,16 +281,30 @@ pub struct SphereSpec {
     pub fixed: bool,
 }
 
+/// The largest case file (bytes) read: its spheres listed one by one included, a case is text
+/// a person writes or a tool generates, far below this.
+pub const MAX_CASE_BYTES: u64 = 64 << 20;
+
 impl Case {
     /// Reads and validates a case file.
     pub fn load(path: &Path) -> Result<Case, CaseError> {
+        use std::io::Read;
         let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| CaseError {
+        let whole = |msg: String| CaseError {
             file: file.clone(),
             line: 0,
             field: "-".into(),
-            msg: format!("cannot read: {e}"),
-        })?;
+            msg,
+        };
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_CASE_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| whole(format!("cannot read: {e}")))?;
+        if bytes.len() as u64 > MAX_CASE_BYTES {
+            return Err(whole(format!(
+                "larger than the {MAX_CASE_BYTES} bytes a case file may have (not a case file?)"
+            )));
+        }
         let text = String::from_utf8(bytes).map_err(|e| {
             let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
             CaseError {
@@ -402,11 +416,16 @@ impl Case {
                 Err(err(table, key, format!("must be >= 0, got {v}")))
             }
         };
-        if self.name.is_empty() || self.name.contains('/') {
+        if !crate::io::plain_file_name(&self.name) {
             return Err(err(
                 "",
                 "name",
-                format!("must be a plain file name, got {:?}", self.name),
+                format!(
+                    "must be a plain file name (1 to {} bytes, no '/', no control character, not \
+                     '.' or '..'), got {:?}",
+                    crate::io::NAME_BYTES,
+                    self.name
+                ),
             ));
         }
         if self.run.save_every == 0 {
@@ -469,6 +488,7 @@ impl Case {
         if c.mu > 0.0 {
             positive("contact", "kt", c.kt)?;
         }
+        self.validate_derived(at)?;
         if self.tc_free_free().is_none() && self.run.steps_per_collision.is_some() {
             return Err(err(
                 "run",
@@ -482,6 +502,66 @@ impl Case {
         }
         self.validate_scene(at)?;
         self.validate_time_step(at)
+    }
+
+    /// Refuses parameters whose derived quantities a double cannot hold: a sphere's mass, the
+    /// collision time and the time step zero, subnormal or infinite, tc/dt not finite, or the
+    /// elastic energy at the guard's overlap limit overflowing. Each error names the field
+    /// the quantity comes from.
+    fn validate_derived(&self, at: &Locator<'_>) -> Result<(), CaseError> {
+        let representable = |v: f64| v.is_finite() && v >= f64::MIN_POSITIVE;
+        let m = self.particle_mass();
+        if !representable(m) {
+            return Err(at.error(
+                "material.density",
+                format!(
+                    "the sphere's mass 4/3 pi r^3 rho = {m:e} (diameter {}, density {}) is not \
+                     a representable positive number",
+                    self.material.diameter, self.material.density
+                ),
+            ));
+        }
+        let tc = self.tc_free_free();
+        if let Some(tc) = tc.filter(|&tc| !representable(tc)) {
+            return Err(at.error(
+                "contact.kn",
+                format!(
+                    "the free–free collision time pi/sqrt(kn/meff - (gamman/2meff)^2) = {tc:e} \
+                     (kn = {:e}, meff = {:e}) is not a representable positive number",
+                    self.contact.kn,
+                    0.5 * m
+                ),
+            ));
+        }
+        let field = if self.run.dt.is_some() {
+            "run.dt"
+        } else {
+            "run.steps_per_collision"
+        };
+        let dt = self.dt();
+        if !representable(dt) {
+            return Err(at.error(
+                field,
+                format!("the time step dt = {dt:e} is not a representable positive number"),
+            ));
+        }
+        if let Some(tc) = tc.filter(|tc| !(tc / dt).is_finite()) {
+            return Err(at.error(field, format!("tc/dt = {tc:e}/{dt:e} is not finite")));
+        }
+        let (_, largest) = self.largest_diameters();
+        let reach = self.guard.overlap * 0.5 * largest;
+        let elastic = 0.5 * self.contact.kn * reach * reach;
+        if !elastic.is_finite() {
+            return Err(at.error(
+                "contact.kn",
+                format!(
+                    "the elastic energy 1/2 kn delta^2 at the guard's overlap limit (delta = \
+                     {reach:e}) overflows: kn = {:e} is too stiff to be represented",
+                    self.contact.kn
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The box against the spheres, the walls against each other and the box, the number of

@@ -74,7 +74,8 @@ impl RunSummary {
     /// the run's `threads` and its rate (steps per second).
     pub fn toml(&self, case: &str, threads: usize) -> String {
         format!(
-            "case = {case:?}\nstep = {}\ntime = {}\nhash = {:?}\nthreads = {threads}\nsteps_per_second = {}\n",
+            "case = {}\nstep = {}\ntime = {}\nhash = {:?}\nthreads = {threads}\nsteps_per_second = {}\n",
+            crate::io::toml_string(case),
             self.step,
             self.time,
             self.hash,
@@ -173,13 +174,15 @@ const OWN_FILES: [&str; 11] = [
 /// Makes `dir` ready for a new run named `name`: a folder that holds the files of an earlier
 /// run of that name ([`run_files`]) is refused, naming the folder and the files, unless `force`
 /// is set; then those files are removed first (so no save of the earlier run is mistaken for
-/// one of the new run). `flag` is the option that sets `force` (for the message). Returns the
-/// number of files removed.
+/// one of the new run). `flag` is the option that sets `force` (for the message). `_held` is
+/// the lock of `dir`, or of a folder that holds it, taken first ([`crate::io::lock`]), so that
+/// no other run writes there meanwhile. Returns the number of files removed.
 pub fn claim_output_folder(
     dir: &Path,
     name: &str,
     force: bool,
     flag: &str,
+    _held: &crate::io::lock::FolderLock,
 ) -> anyhow::Result<usize> {
     let found = run_files(dir, name)?;
     if found.is_empty() {

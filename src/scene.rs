@@ -11,7 +11,7 @@ use crate::case::{Case, Scene as SceneSpec, Search};
 use crate::io::{mercury, official};
 use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::Domain;
-use crate::state::{Motion, Particles};
+use crate::state::{memory, Motion, Particles};
 use crate::Vec3;
 
 /// The initial state of a run.
@@ -56,6 +56,10 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                 (bumpy_wall(*wall_rows, *wall_per_row, d, *top_z), *top_vx),
             ];
             let n_wall = 2 * wall_rows * wall_per_row;
+            memory::check(
+                &format!("scene: {n_wall} wall + {free} free spheres"),
+                (n_wall as f64 + *free as f64) * memory::BYTES_PER_SPHERE,
+            )?;
             let wall_of = |a: usize| (a < n_wall).then(|| (a / (wall_rows * wall_per_row)) as u8);
             let init_path = init
                 .map(Path::to_path_buf)
@@ -129,6 +133,10 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
             }
         }
         SceneSpec::Gas { count, speed } => {
+            memory::check(
+                &format!("scene.count: {count} spheres"),
+                *count as f64 * memory::BYTES_PER_SPHERE,
+            )?;
             let z = (domain.lo.z + 0.5 * d, domain.hi.z - 0.5 * d);
             let x = random_fill(&domain, &[], *count, d, z, case.run.seed)?;
             for (x, v) in x
@@ -159,11 +167,26 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
     for x in particles.x.iter_mut() {
         domain.wrap(x);
     }
+    pairs_fit(&particles, case.neighbor.skin)?;
     Ok(Scene {
         domain,
         particles,
         time,
     })
+}
+
+/// Refuses spheres whose neighbour list (with skin `skin`) would not fit in memory, before it is
+/// built ([`memory::candidate_pairs`]).
+fn pairs_fit(p: &Particles, skin: f64) -> Result<(), memory::TooLarge> {
+    let pairs = memory::candidate_pairs(&p.x, &p.radius, skin);
+    memory::check(
+        &format!(
+            "the neighbour list of {} spheres (up to {pairs:.3e} pairs in reach: spheres \
+             piled on each other?)",
+            p.len()
+        ),
+        pairs * memory::BYTES_PER_PAIR,
+    )
 }
 
 /// What an initial file provides.
@@ -234,6 +257,7 @@ fn check_loaded(
             );
         }
     }
+    pairs_fit(p, 0.0)?;
     let free = |a: usize| matches!(p.motion[a], Motion::Free);
     for (a, b) in overlapping_pairs(p, domain) {
         if !free(a) && !free(b) {

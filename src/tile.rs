@@ -29,6 +29,15 @@ pub fn tile_state(s: &Snapshot, density: f64, nx: usize, ny: usize) -> anyhow::R
     if nx == 0 || ny == 0 {
         bail!("tiles: nx and ny must be 1 or more, got {nx} × {ny}");
     }
+    let spheres = s.particles.len() as f64 * nx as f64 * ny as f64;
+    // The tiled state, its `.data` text (~200 bytes a sphere) and the run that follows.
+    crate::state::memory::check(
+        &format!(
+            "tiles {nx} × {ny} of {} spheres ({spheres:.3e} spheres)",
+            s.particles.len()
+        ),
+        spheres * (crate::state::memory::BYTES_PER_SPHERE + 200.0),
+    )?;
     if !(s.domain.periodic[0] && s.domain.periodic[1]) {
         bail!(
             "tiles: the box must be periodic in x and y, got periodic = {:?}",
@@ -160,8 +169,7 @@ pub fn write(
     out: &Path,
 ) -> anyhow::Result<(PathBuf, PathBuf)> {
     let case = Case::load(case_path)?;
-    let text = std::fs::read_to_string(case_path)
-        .with_context(|| format!("{}: cannot read", case_path.display()))?;
+    let (_, text) = crate::io::read_text(case_path)?;
     let name = tiled_name(&case.name, nx, ny);
     let data = format!("{name}.data");
     let case_text = tile_case_text(&text, &case_path.display().to_string(), nx, ny, &data)?;

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
+use verdem::state::memory;
 
 use super::args::{count, named, positive};
 use super::Finished;
@@ -53,6 +54,12 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         blocks: a.blocks,
         ..saves
     };
+    // Each save's raw fields and each block's profiles: some 64 numbers a slice.
+    let saves = cg::Series::find(&a.base).map_or(1, |s| s.saves.len());
+    memory::check(
+        &format!("--slices {} over {saves} saves", a.slices),
+        a.slices as f64 * 64.0 * 8.0 * (saves + a.blocks) as f64,
+    )?;
     let (_, report) = cg::write_all(&a.base, &o)?;
     print!("{report}");
     Ok(Finished::Done)

@@ -3,7 +3,10 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
+
 use verdem::case::{Case, Tangential};
+use verdem::io::lock::{self, FolderLock};
 use verdem::peers::{cross, Peer};
 use verdem::run;
 
@@ -62,8 +65,11 @@ pub struct Args {
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let case = Case::load(&a.case)?;
     let out = a.out.join(a.peer.binary());
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("{}: cannot create output folder", out.display()))?;
+    let lock = FolderLock::take(&out, &lock::this_command())?;
     for series in [a.peer.binary(), "verdem"] {
-        run::claim_output_folder(&out.join(series), &case.name, a.force, "--force")?;
+        run::claim_output_folder(&out.join(series), &case.name, a.force, "--force", &lock)?;
     }
     let convention = a.convention.unwrap_or(a.peer.convention());
     let inrun = a

@@ -10,6 +10,7 @@ use anyhow::Context;
 
 use verdem::case::Case;
 use verdem::ensemble::{self, local, slurm, Plan, ReplicaCommand};
+use verdem::io::lock::{self, FolderLock};
 
 use super::args::{count, named, non_negative, positive};
 use super::Finished;
@@ -127,6 +128,17 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     if replicas < 2 {
         anyhow::bail!(
             "--replicas {replicas}: an ensemble needs 2 replicas or more for its error bars"
+        );
+    }
+    std::fs::create_dir_all(&plan.out)
+        .with_context(|| format!("{}: cannot create", plan.out.display()))?;
+    // Held until the merged files are written.
+    let lock = FolderLock::take(&plan.out, &lock::this_command())?;
+    if let Some(holder) = lock.stale() {
+        eprintln!(
+            "warning: {}: an ensemble that did not end had locked this folder ({holder}); its \
+             lock is taken over",
+            plan.out.display()
         );
     }
     let engine = if a.merge {

@@ -12,6 +12,7 @@ use verdem::analysis::cg::{self, CgOptions};
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::analysis::particles;
 use verdem::case::{Case, Scene};
+use verdem::io::lock::{self, FolderLock};
 use verdem::io::vtk::Particle;
 use verdem::io::{atomic, checkpoint, mercury};
 use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
@@ -28,7 +29,7 @@ pub struct Args {
     /// The run ends at this step (default: the case's `run.steps`), also after --resume.
     #[arg(long)]
     steps: Option<u64>,
-    /// Output folder (default: out/NAME).
+    /// Output folder (default: out/NAME; with --resume, the checkpoint's folder).
     #[arg(long)]
     out: Option<PathBuf>,
     /// A save every N steps (default: the case's `run.save_every`).
@@ -102,17 +103,28 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             engine.state().step
         );
     }
-    let out_dir = a
-        .out
-        .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
+    let out_dir = match (a.out, &a.resume) {
+        (Some(out), _) => out,
+        (None, Some(ck)) => checkpoint_folder(ck).to_path_buf(),
+        (None, None) => PathBuf::from("out").join(&case.name),
+    };
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("{}: cannot create output folder", out_dir.display()))?;
+    let lock = FolderLock::take(&out_dir, &lock::this_command())?;
+    if let Some(holder) = lock.stale() {
+        eprintln!(
+            "warning: {}: a run that did not end (killed, or its machine stopped) had locked \
+             this folder ({holder}); its lock is taken over",
+            out_dir.display()
+        );
+    }
     // A resumed run continues in its checkpoint's folder, which holds its saves by design.
     let own_folder = |ck: &PathBuf| {
-        let folder = ck.parent().filter(|d| !d.as_os_str().is_empty());
         let canonical = |p: &Path| std::fs::canonicalize(p).ok();
-        canonical(folder.unwrap_or(Path::new("."))) == canonical(&out_dir)
+        canonical(checkpoint_folder(ck)) == canonical(&out_dir)
     };
     if !a.resume.as_ref().is_some_and(own_folder) {
-        let removed = run::claim_output_folder(&out_dir, &case.name, a.force, "--force")?;
+        let removed = run::claim_output_folder(&out_dir, &case.name, a.force, "--force", &lock)?;
         if removed > 0 {
             println!(
                 "removed the {removed} files of an earlier run {:?} from {} (--force)",
@@ -359,6 +371,13 @@ fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
     })
     .context("cannot install the signal handler")?;
     Ok(stop)
+}
+
+/// The folder of the checkpoint `ck` (`.` for a bare file name), which holds its run's saves.
+fn checkpoint_folder(ck: &Path) -> &Path {
+    ck.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
 }
 
 /// This process's command line with `--resume CHECKPOINT` in place of any `--resume` it had,

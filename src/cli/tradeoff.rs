@@ -7,6 +7,7 @@ use anyhow::Context;
 use verdem::analysis::tradeoff::{self, Plan};
 use verdem::case::Case;
 use verdem::io::atomic;
+use verdem::io::lock::{self, FolderLock};
 use verdem::run;
 
 use super::args::{count, fraction, positive};
@@ -68,14 +69,20 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         return Ok(Finished::Done);
     }
     let pair = Case::load(&a.pair)?;
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("{}: cannot create output folder", a.out.display()))?;
+    let lock = FolderLock::take(&a.out, &lock::this_command())?;
     for variant in std::fs::read_dir(&a.out).into_iter().flatten().flatten() {
-        run::claim_output_folder(&variant.path(), &case.name, a.force, "--force")?;
+        if !variant.path().is_dir() {
+            continue;
+        }
+        run::claim_output_folder(&variant.path(), &case.name, a.force, "--force", &lock)?;
         for replica in std::fs::read_dir(variant.path())
             .into_iter()
             .flatten()
             .flatten()
         {
-            run::claim_output_folder(&replica.path(), &case.name, a.force, "--force")?;
+            run::claim_output_folder(&replica.path(), &case.name, a.force, "--force", &lock)?;
         }
     }
     let plan = Plan {

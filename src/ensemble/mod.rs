@@ -30,6 +30,7 @@ use crate::analysis::ensemble::{self as merge, CoreCoverage, Coverage};
 use crate::analysis::inrun::{self, Inrun};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
+use crate::io::lock::{self, FolderLock};
 use crate::io::{atomic, hash};
 use crate::run::{self, RunOptions};
 use crate::scene;
@@ -181,8 +182,7 @@ impl Record {
     }
 
     fn read(path: &Path) -> anyhow::Result<Record> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read the replica's record", path.display()))?;
+        let (_, text) = crate::io::read_text(path).context("cannot read the replica's record")?;
         toml::from_str(&text).with_context(|| format!("{}: not a replica record", path.display()))
     }
 }
@@ -196,6 +196,11 @@ impl Plan {
     /// Refuses a plan whose start files do not fit it: `starts` together with `init`, or a
     /// number of start files other than the number of replicas.
     pub fn validate(&self) -> anyhow::Result<()> {
+        // Each replica's folder, record and profiles are held for the merge: some 1 MiB each.
+        crate::state::memory::check(
+            &format!("--replicas {}", self.replicas),
+            self.replicas as f64 * (1u64 << 20) as f64,
+        )?;
         if self.starts.is_empty() {
             return Ok(());
         }
@@ -292,7 +297,10 @@ impl Plan {
         );
         let start_hash = hash::state_hash(&engine.snapshot());
         let dir = replica_dir(&self.out, k);
-        run::claim_output_folder(&dir, &case.name, true, "--replica")?;
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("{}: cannot create", dir.display()))?;
+        let lock = FolderLock::take(&dir, &lock::this_command())?;
+        run::claim_output_folder(&dir, &case.name, true, "--replica", &lock)?;
         let opts = RunOptions {
             end_step: self.steps.unwrap_or(case.run.steps),
             save_every: self.save_every.unwrap_or(case.run.save_every),

@@ -145,9 +145,7 @@ pub struct LedgerRecord {
 /// ledger columns (a table written before they existed). A field that is not a number, or a
 /// ledger that is only partly filled in, is an error naming the file, line and column.
 pub fn read_ledgers(path: &Path) -> anyhow::Result<Option<Vec<LedgerRecord>>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    let file = path.display().to_string();
+    let (file, text) = super::read_text(path)?;
     let names: Vec<&str> = CSV_HEADER.trim_end().split(',').collect();
     let mut rows = Vec::new();
     let mut at: Option<Vec<usize>> = None;

@@ -1,11 +1,13 @@
 //! Files: MercuryCG `.data`/`.fstat` saves, the official initial-configuration format,
-//! checkpoints, the state hash, the diagnostics table, ParaView's VTK files, atomic writes.
+//! checkpoints, the state hash, the diagnostics table, ParaView's VTK files, atomic writes, the
+//! output folder's lock.
 
 pub mod atomic;
 pub mod checkpoint;
 pub mod csv_table;
 pub mod diagnostics;
 pub mod hash;
+pub mod lock;
 pub mod mercury;
 pub mod official;
 pub mod vtk;
@@ -33,6 +35,41 @@ impl std::fmt::Display for FormatError {
     }
 }
 
+/// The longest name of a case (bytes), which every output file's name begins with.
+pub const NAME_BYTES: usize = 200;
+
+/// Whether `name` can begin the name of a file in an output folder without leaving it or
+/// making a name that a terminal or a table would mangle: 1 to [`NAME_BYTES`] bytes, no `/`,
+/// no control character, not `.` or `..`.
+pub fn plain_file_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= NAME_BYTES
+        && name != "."
+        && name != ".."
+        && !name.chars().any(|c| c == '/' || c.is_control())
+}
+
+/// `text` escaped for an XML attribute value or element text (`&`, `<`, `>`, `"` and `'`).
+pub fn xml_escaped(text: &str) -> String {
+    let mut s = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => s.push_str("&amp;"),
+            '<' => s.push_str("&lt;"),
+            '>' => s.push_str("&gt;"),
+            '"' => s.push_str("&quot;"),
+            '\'' => s.push_str("&apos;"),
+            c => s.push(c),
+        }
+    }
+    s
+}
+
+/// `text` as a TOML basic string, quotes included, escaped as TOML requires.
+pub fn toml_string(text: &str) -> String {
+    toml::Value::String(text.into()).to_string()
+}
+
 /// Formats an f64 so that it reads back to the same bits: plain decimal for moderate
 /// magnitudes, shortest exponent form otherwise.
 pub fn fmt_f64(out: &mut String, v: f64) {
@@ -45,15 +82,41 @@ pub fn fmt_f64(out: &mut String, v: f64) {
     }
 }
 
-/// Reads a text file whole; returns its name (for messages) and its text. Bytes that are not
-/// UTF-8 are an error naming their line.
-pub fn read_text(path: &Path) -> Result<(String, String), FormatError> {
+/// The longest line (bytes) a text reader takes: a longer one, or a stream with no line end
+/// (a binary file, `/dev/zero`), is an error before it is held in memory.
+pub const MAX_LINE: usize = 1 << 20;
+
+/// The largest file (bytes) read whole ([`read_text`], [`read_bounded`]).
+pub const MAX_FILE: u64 = 1 << 30;
+
+/// Reads a file whole, at most `most` bytes: a larger file, or an endless stream (a device, a
+/// pipe), is an error naming it before more than `most` bytes are held.
+pub fn read_bounded(path: &Path, most: u64) -> Result<Vec<u8>, FormatError> {
+    use std::io::Read;
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| FormatError {
+    let cannot = |e: std::io::Error| FormatError {
         file: file.clone(),
         line: 0,
         msg: format!("cannot read: {e}"),
-    })?;
+    };
+    let f = File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::new();
+    f.take(most + 1).read_to_end(&mut bytes).map_err(cannot)?;
+    if bytes.len() as u64 > most {
+        return Err(FormatError {
+            file,
+            line: 0,
+            msg: format!("larger than the {most} bytes a file of this kind may have"),
+        });
+    }
+    Ok(bytes)
+}
+
+/// Reads a text file whole (at most [`MAX_FILE`] bytes); returns its name (for messages) and
+/// its text. Bytes that are not UTF-8 are an error naming their line.
+pub fn read_text(path: &Path) -> Result<(String, String), FormatError> {
+    let file = path.display().to_string();
+    let bytes = read_bounded(path, MAX_FILE)?;
     let text = utf8(&file, bytes)?;
     Ok((file, text))
 }
@@ -146,15 +209,29 @@ impl<R: BufRead> Lines<R> {
         })
     }
 
-    /// The next line and its number, `None` at the end of the stream.
+    /// The next line and its number, `None` at the end of the stream. A line longer than
+    /// [`MAX_LINE`] bytes is an error.
     pub fn next_line(&mut self) -> Result<Option<(usize, &str)>, FormatError> {
+        use std::io::Read;
         self.buf.clear();
-        let read = self.reader.read_until(b'\n', &mut self.buf);
+        let limit = MAX_LINE as u64 + 2;
+        let read = (&mut self.reader)
+            .take(limit)
+            .read_until(b'\n', &mut self.buf);
         self.line += 1;
         match read {
             Ok(0) => {
                 self.line -= 1;
                 return Ok(None);
+            }
+            Ok(n) if n as u64 == limit && self.buf.last() != Some(&b'\n') => {
+                return Err(self.error(
+                    self.line,
+                    format!(
+                        "a line longer than {MAX_LINE} bytes, or no line end at all (a binary \
+                         file, or a device?)"
+                    ),
+                ))
             }
             Ok(_) => {}
             Err(e) => return Err(self.error(self.line, format!("cannot read: {e}"))),
@@ -281,6 +358,61 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "a.data:7: column 3: not finite: \"nan\" (expected a finite number)"
+        );
+    }
+
+    #[test]
+    fn names_that_leave_the_folder_or_hold_control_characters_are_not_plain() {
+        for bad in [
+            "",
+            ".",
+            "..",
+            "a/b",
+            "../x",
+            "a\nb",
+            "a\u{1b}[31m",
+            &"x".repeat(201),
+        ] {
+            assert!(!plain_file_name(bad), "{bad:?}");
+        }
+        for good in ["shear_flow", "a<b&c\"d", "..x", "é"] {
+            assert!(plain_file_name(good), "{good:?}");
+        }
+    }
+
+    #[test]
+    fn xml_and_toml_escapes_read_back() {
+        let name = "a<b&c\"d'e>";
+        assert_eq!(xml_escaped(name), "a&lt;b&amp;c&quot;d&apos;e&gt;");
+        let t: toml::Table = format!("k = {}", toml_string("a\"b\\c\u{7}"))
+            .parse()
+            .unwrap();
+        assert_eq!(t["k"].as_str(), Some("a\"b\\c\u{7}"));
+    }
+
+    #[test]
+    fn an_endless_line_is_refused_before_it_is_held() {
+        let endless = std::io::BufReader::new(std::io::repeat(b'0'));
+        let mut lines = Lines::new("zero", endless);
+        let e = lines.next_line().unwrap_err().to_string();
+        assert!(e.starts_with("zero:1: a line longer than"), "{e}");
+        let long = format!("{}\nb\n", "a".repeat(MAX_LINE));
+        let mut lines = Lines::new("f", long.as_bytes());
+        assert_eq!(
+            lines.next_line().unwrap().map(|(_, l)| l.len()),
+            Some(MAX_LINE)
+        );
+        assert_eq!(lines.next_line().unwrap(), Some((2, "b")));
+    }
+
+    #[test]
+    fn an_endless_file_is_refused_when_read_whole() {
+        let e = read_bounded(Path::new("/dev/zero"), 1000)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "/dev/zero: larger than the 1000 bytes a file of this kind may have"
         );
     }
 }

@@ -310,7 +310,10 @@ pub fn pvd_text(entries: &[(f64, String)]) -> String {
     for (time, file) in entries {
         s.push_str("    <DataSet timestep=\"");
         fmt_f64(&mut s, *time);
-        s.push_str(&format!("\" group=\"\" part=\"0\" file=\"{file}\"/>\n"));
+        s.push_str(&format!(
+            "\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+            super::xml_escaped(file)
+        ));
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     s
@@ -409,6 +412,13 @@ mod tests {
                 periodic: false,
             }],
         }
+    }
+
+    #[test]
+    fn a_name_with_markup_is_escaped_in_the_collection() {
+        let s = pvd_text(&[(0.5, vtu_name("a<b&c\"d", 3))]);
+        assert!(s.contains("file=\"a&lt;b&amp;c&quot;d.0003.vtu\""), "{s}");
+        assert!(!s.contains("a<b"), "{s}");
     }
 
     #[test]

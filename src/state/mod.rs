@@ -2,6 +2,7 @@
 
 pub mod domain;
 pub mod history;
+pub mod memory;
 pub mod snapshot;
 pub mod tally;
 

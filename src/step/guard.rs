@@ -135,9 +135,9 @@ impl Breach {
                 format!(
                     "{} is not finite",
                     if angular {
-                        "angular velocity"
+                        "angular velocity (or its kinetic energy 1/2 I w^2)"
                     } else {
-                        "velocity"
+                        "velocity (or its kinetic energy 1/2 m v^2)"
                     }
                 ),
                 "the state the run was given holds it (the step itself checks the forces that \
@@ -241,16 +241,23 @@ pub(super) fn outside(
         })
 }
 
-/// The first free particle (memory order) whose velocity or angular velocity is not finite.
+/// The first free particle (memory order) whose velocity or angular velocity is not finite,
+/// or so large that its kinetic energy (½ m v², ½ I ω²) is not: every energy the diagnostics
+/// table reports must be a number.
 pub(super) fn not_finite(pt: &crate::state::Particles) -> Option<Breach> {
-    let finite = |v: &crate::Vec3| (v.x + v.y + v.z).is_finite();
+    let finite = |v: &crate::Vec3, inv: f64| (0.5 * v.norm_squared() / inv).is_finite();
     (0..pt.len())
         .filter(|&a| pt.inv_mass[a] > 0.0)
-        .find_map(|a| match (finite(&pt.v[a]), finite(&pt.w[a])) {
-            (true, true) => None,
-            (v, _) => Some(Breach::NotFinite {
-                particle: a,
-                angular: v,
-            }),
+        .find_map(|a| {
+            match (
+                finite(&pt.v[a], pt.inv_mass[a]),
+                finite(&pt.w[a], pt.inv_inertia[a]),
+            ) {
+                (true, true) => None,
+                (v, _) => Some(Breach::NotFinite {
+                    particle: a,
+                    angular: v,
+                }),
+            }
         })
 }

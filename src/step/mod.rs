@@ -184,7 +184,15 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     }
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
-            self.initial_forces();
+            // The state given is checked before its forces are evaluated and saved, so that no
+            // save or diagnostics row is made of velocities the guard would refuse.
+            match guard::not_finite(&self.core.state.particles) {
+                Some(b) => {
+                    let state = &self.core.state;
+                    self.core.failure = Some(b.report(state.step, state.time, &state.id));
+                }
+                None => self.initial_forces(),
+            }
         }
         if steps == 0 || self.core.failure.is_some() {
             return self.core.failure.clone().map_or(Ok(()), Err);

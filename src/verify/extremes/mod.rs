@@ -243,8 +243,7 @@ pub fn unset(text: &str, table: &str, key: &str) -> String {
 
 /// The case file `path` as text and parsed.
 pub fn load(path: &Path) -> anyhow::Result<(String, Case)> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+    let (_, text) = crate::io::read_text(path)?;
     Ok((text, Case::load(path)?))
 }
 
