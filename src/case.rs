@@ -533,21 +533,6 @@ impl Case {
                 ),
             ));
         }
-        let field = if self.run.dt.is_some() {
-            "run.dt"
-        } else {
-            "run.steps_per_collision"
-        };
-        let dt = self.dt();
-        if !representable(dt) {
-            return Err(at.error(
-                field,
-                format!("the time step dt = {dt:e} is not a representable positive number"),
-            ));
-        }
-        if let Some(tc) = tc.filter(|tc| !(tc / dt).is_finite()) {
-            return Err(at.error(field, format!("tc/dt = {tc:e}/{dt:e} is not finite")));
-        }
         let (_, largest) = self.largest_diameters();
         let reach = self.guard.overlap * 0.5 * largest;
         let elastic = 0.5 * self.contact.kn * reach * reach;
@@ -560,6 +545,24 @@ impl Case {
                     self.contact.kn
                 ),
             ));
+        }
+        let field = if self.run.dt.is_some() {
+            "run.dt"
+        } else if tc.is_some() {
+            "run.steps_per_collision"
+        } else {
+            // No collision time to divide: refused next, as an over-damped contact.
+            return Ok(());
+        };
+        let dt = self.dt();
+        if !representable(dt) {
+            return Err(at.error(
+                field,
+                format!("the time step dt = {dt:e} is not a representable positive number"),
+            ));
+        }
+        if let Some(tc) = tc.filter(|tc| !(tc / dt).is_finite()) {
+            return Err(at.error(field, format!("tc/dt = {tc:e}/{dt:e} is not finite")));
         }
         Ok(())
     }

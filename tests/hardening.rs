@@ -331,3 +331,37 @@ fn a_name_with_markup_is_escaped_and_one_with_control_characters_refused() {
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains(": name: must be a plain file name"), "{err}");
 }
+
+#[test]
+fn every_text_writer_s_output_with_a_non_finite_value_is_refused_by_the_one_writer() {
+    use verdem::io::{atomic, csv_table, diagnostics, mercury, vtk};
+    let case = verdem::case::Case::load(&common::root().join(PAIR)).unwrap();
+    let mut engine = common::engine(&case, None, Default::default());
+    engine.advance(5).unwrap();
+    let mut snap = engine.snapshot();
+    snap.particles.v[0].x = f64::NAN;
+    snap.particles.w[1].y = f64::INFINITY;
+    let dir = tempfile::tempdir().unwrap();
+    let texts = [
+        ("a.data.0000", mercury::data_text(&snap)),
+        ("a.0000.vtu", vtk::vtu_text(&vtk::Frame::of_snapshot(&snap))),
+        ("a.pvd", vtk::pvd_text(&[(f64::NAN, "a.0000.vtu".into())])),
+        (
+            "a.diagnostics.csv",
+            diagnostics::Diagnostics::of(&snap, 0).csv_row(),
+        ),
+        ("a.csv", csv_table::write(["x"], [[-f64::INFINITY]])),
+    ];
+    for (name, text) in texts {
+        let p = dir.path().join(name);
+        let e = atomic::write(&p, text.as_bytes()).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("{}: not written: line ", p.display())),
+            "{name}: {e}"
+        );
+        let e = atomic::append(&p, text.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("non-finite number"), "{name}: {e}");
+        assert!(!p.exists(), "{name} was written");
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

@@ -130,6 +130,9 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             "--replicas {replicas}: an ensemble needs 2 replicas or more for its error bars"
         );
     }
+    if !a.merge {
+        plan.check()?;
+    }
     std::fs::create_dir_all(&plan.out)
         .with_context(|| format!("{}: cannot create", plan.out.display()))?;
     // Held until the merged files are written.
@@ -144,7 +147,6 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let engine = if a.merge {
         "merge"
     } else {
-        plan.check()?;
         plan.claim(&case.name, a.force)?;
         let cmd = replica_command(&plan)?;
         let outcomes = match a.engine {

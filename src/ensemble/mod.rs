@@ -176,7 +176,10 @@ impl Record {
     /// The `start_file` and `start_sha256` lines (TOML), none for a generated scene.
     fn start_lines(&self) -> String {
         match (&self.start_file, &self.start_sha256) {
-            (Some(file), Some(sha)) => format!("start_file = {file:?}\nstart_sha256 = {sha:?}\n"),
+            (Some(file), Some(sha)) => format!(
+                "start_file = {}\nstart_sha256 = {sha:?}\n",
+                crate::io::toml_string(file)
+            ),
             _ => String::new(),
         }
     }
@@ -332,9 +335,12 @@ impl Plan {
                 &inrun::errors_csv_path(&dir, &case.name),
                 inrun::errors_csv(&r).as_bytes(),
             )?;
+            // A column without fluctuations (τ = 0) would have infinite degrees of freedom: a
+            // variance from n units has at most n − 1, which keeps the record finite.
+            let most = (r.units.len() as f64 - 1.0).max(1.0);
             inrun_dof = cg::FIELDS
                 .iter()
-                .map(|&(_, c)| blocking::degrees_of_freedom(&r.errors, c, r.units.len()))
+                .map(|&(_, c)| blocking::degrees_of_freedom(&r.errors, c, r.units.len()).min(most))
                 .collect();
         }
         let record = Record {
