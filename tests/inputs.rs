@@ -508,7 +508,7 @@ fn a_checkpoint_of_another_case_law_step_count_or_version_is_refused_saying_what
         &[
             "small_v1.checkpoint",
             "checkpoint format version 1",
-            "reads version 2",
+            "reads versions 2 to 4",
         ],
     );
     let cut = dir.path().join("cut.checkpoint");
@@ -573,6 +573,239 @@ fn a_checkpoint_with_other_history_words_or_a_non_finite_number_is_refused_namin
     assert_eq!(
         checkpoint::restore("c.ck", &bytes, e.as_mut(), &tag).unwrap(),
         10
+    );
+}
+
+/// The checkpoint this verdem writes of the seed's run at step 10, with a run record (the
+/// ledgers with their last save's reading, and an observer's state), and the engine it holds.
+fn written_checkpoint(dir: &Path) -> (PathBuf, Vec<u8>, checkpoint::RunRecord, Box<dyn Engine>) {
+    let mut e = small_engine();
+    e.advance(10).unwrap();
+    let record = checkpoint::RunRecord {
+        ledgers: Some(checkpoint::Ledgers {
+            flows: e.flows(),
+            last_save: Some(e.ledger()),
+        }),
+        observer: Some(b"the observer's sums".to_vec()),
+    };
+    let p = dir.join("c.checkpoint");
+    let tag = checkpoint::tag(&small_case());
+    checkpoint::write_run(&p, &e.snapshot(), e.params().dt, &tag, &record).unwrap();
+    (p.clone(), std::fs::read(&p).unwrap(), record, e)
+}
+
+/// The bits of everything a checkpoint holds of `s`: step, time, and every number of its
+/// particles and contacts.
+fn state_bits(s: &verdem::state::Snapshot) -> Vec<u64> {
+    let p = &s.particles;
+    let mut out = vec![s.step, s.time.to_bits()];
+    let put = |out: &mut Vec<u64>, v: &verdem::Vec3| out.extend(v.iter().map(|x| x.to_bits()));
+    for a in 0..p.len() {
+        for v in [&p.x[a], &p.v[a], &p.w[a], &p.f[a], &p.t[a]] {
+            put(&mut out, v);
+        }
+    }
+    for c in &s.contacts {
+        let f = &c.force;
+        for v in [&f.f, &f.torque_p, &f.torque_i] {
+            put(&mut out, v);
+        }
+        out.extend([u64::from(c.p), u64::from(c.i), f.fn_signed.to_bits()]);
+        out.extend(c.history.iter().map(|w| w.to_bits()));
+    }
+    out
+}
+
+/// The SHA-256 digest of `bytes`.
+fn sha256(bytes: &[u8]) -> Vec<u8> {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes).to_vec()
+}
+
+/// The first 8 bytes of `digest` in hex.
+fn short_hex(digest: &[u8]) -> String {
+    digest[..8].iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+fn a_checkpoint_is_not_text_and_resumes_bit_for_bit_with_its_run_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, bytes, record, mut e) = written_checkpoint(dir.path());
+    assert_eq!(bytes[0], 0x89);
+    assert!(std::str::from_utf8(&bytes).is_err());
+    let before = e.snapshot();
+    assert!(
+        !before.contacts.is_empty() && !before.contacts[0].history.is_empty(),
+        "the checkpoint holds contacts with their histories"
+    );
+    let tag = checkpoint::tag(&small_case());
+    let mut resumed = small_engine();
+    let r = checkpoint::read_run(&p, resumed.as_mut(), &tag).unwrap();
+    assert_eq!((r.step, r.version), (10, checkpoint::FORMAT_VERSION));
+    assert_eq!(r.record, record);
+    assert!(r.lacks().is_empty(), "{:?}", r.lacks());
+    assert_eq!(state_bits(&resumed.snapshot()), state_bits(&before));
+    assert_eq!(
+        io::hash::state_hash(&resumed.snapshot()),
+        io::hash::state_hash(&before)
+    );
+    assert_eq!(resumed.flows(), e.flows());
+    e.advance(20).unwrap();
+    resumed.advance(20).unwrap();
+    assert_eq!(
+        io::hash::state_hash(&resumed.snapshot()),
+        io::hash::state_hash(&e.snapshot())
+    );
+}
+
+/// Every single bit of the file flipped in turn, in its header (magic, version, tag, step,
+/// time, dt, counts), its particles, its contacts' histories and forces, its ledgers, its
+/// observer's state and its checksum, and the file cut at every byte: each is refused naming
+/// the file, before anything is restored.
+#[test]
+fn a_checkpoint_with_any_bit_flipped_or_cut_anywhere_is_refused_before_it_is_restored() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, bytes, _, _) = written_checkpoint(dir.path());
+    let name = p.display().to_string();
+    let tag = checkpoint::tag(&small_case());
+    let mut e = small_engine();
+    let untouched = (state_bits(&e.snapshot()), e.flows());
+    let (body, sum) = bytes.split_at(bytes.len() - 32);
+    assert_eq!(sum, sha256(body));
+    for k in 0..bytes.len() {
+        for bit in 0..8 {
+            let mut b = bytes.clone();
+            b[k] ^= 1 << bit;
+            let err = checkpoint::restore(&name, &b, e.as_mut(), &tag)
+                .unwrap_err()
+                .to_string();
+            let expect = if k < 8 {
+                format!("{name}: not a verdem checkpoint")
+            } else {
+                format!("{name}: refused, a corrupted checkpoint")
+            };
+            assert!(err.starts_with(&expect), "byte {k} bit {bit}: {err}");
+        }
+    }
+    // the first particle's x: magic, version, tag length, tag, step, time, dt and two counts
+    let x_at = 8 + 8 + 8 + tag.len() + 8 * 5;
+    let mut b = bytes.clone();
+    b[x_at + 3] ^= 0x10;
+    std::fs::write(&p, &b).unwrap();
+    let err = checkpoint::read(&p, e.as_mut(), &tag)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{name}: refused, a corrupted checkpoint (changed or truncated since it was \
+             written): its checksum says SHA-256 {}…, its {} bytes before it have {}…",
+            short_hex(sum),
+            body.len(),
+            short_hex(&sha256(&b[..body.len()]))
+        )
+    );
+    for len in 0..bytes.len() {
+        let err = checkpoint::restore(&name, &bytes[..len], e.as_mut(), &tag)
+            .unwrap_err()
+            .to_string();
+        let expect = match len {
+            0..8 => "not a verdem checkpoint",
+            8..32 => "checkpoint truncated",
+            _ => "refused, a corrupted checkpoint",
+        };
+        assert!(
+            err.starts_with(&format!("{name}: {expect}")),
+            "cut at {len}: {err}"
+        );
+    }
+    assert!(untouched == (state_bits(&e.snapshot()), e.flows()));
+}
+
+/// A checkpoint of format version 3 (no checksum) still resumes bit for bit, and says that it
+/// carries no checksum; one of format version 2 says it too, beside its lack of ledgers.
+#[test]
+fn a_checkpoint_of_an_older_format_resumes_saying_it_carries_no_checksum() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, bytes, record, e) = written_checkpoint(dir.path());
+    // version 3: the magic of versions 2 and 3, and no checksum
+    let mut v3 = b"VERDEMCK".to_vec();
+    v3.extend_from_slice(&3u64.to_le_bytes());
+    v3.extend_from_slice(&bytes[16..bytes.len() - 32]);
+    let tag = checkpoint::tag(&small_case());
+    let mut resumed = small_engine();
+    let r = checkpoint::restore_run("c3.ck", &v3, resumed.as_mut(), &tag).unwrap();
+    assert_eq!((r.version, &r.record), (3, &record));
+    assert_eq!(state_bits(&resumed.snapshot()), state_bits(&e.snapshot()));
+    assert_eq!(
+        r.lacks(),
+        [
+            "a checkpoint of format version 3 carries no checksum: a change to it since it was \
+          written (a flipped bit) cannot be detected"
+        ]
+    );
+    let r = checkpoint::read_run(&corpus("small.checkpoint"), resumed.as_mut(), &tag).unwrap();
+    let lacks = r.lacks();
+    assert_eq!(lacks.len(), 2, "{lacks:?}");
+    assert!(lacks[0].starts_with("a checkpoint of format version 2 carries no checksum"));
+    assert!(lacks[1].starts_with("a checkpoint of format version 2 holds no ledgers"));
+}
+
+/// `bytes` with its checksum made again for its changed body.
+fn resealed(bytes: &[u8]) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    b.extend_from_slice(&sha256(bytes));
+    b
+}
+
+#[test]
+fn an_absurd_count_in_a_checkpoint_is_refused_before_anything_is_reserved_for_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, bytes, record, _) = written_checkpoint(dir.path());
+    let body = &bytes[..bytes.len() - 32];
+    let tag = checkpoint::tag(&small_case());
+    let huge = (1u64 << 60).to_le_bytes();
+    let contacts_at = 8 + 8 + 8 + tag.len() + 8 * 5 + 20 * 15 * 8;
+    let observer_at = body.len() - record.observer.as_ref().unwrap().len() - 8;
+    let len = body.len();
+    for (at, expect) in [
+        (
+            16,
+            format!("c.ck: checkpoint truncated at byte 24 (of {len}; 1152921504606846976 more"),
+        ),
+        (
+            contacts_at,
+            format!(
+                "c.ck: byte {contacts_at}: the contact count is 1152921504606846976, more than"
+            ),
+        ),
+        (
+            observer_at,
+            format!(
+                "c.ck: byte {observer_at}: the observer's state length is 1152921504606846976, \
+                 more than {len}"
+            ),
+        ),
+    ] {
+        let mut b = body.to_vec();
+        b[at..at + 8].copy_from_slice(&huge);
+        let mut e = small_engine();
+        let err = checkpoint::restore("c.ck", &resealed(&b), e.as_mut(), &tag)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with(&expect),
+            "{expect:?} is not the start of {err:?}"
+        );
+    }
+    let mut r = checkpoint::Reader::new("c.ck", &huge, 100, "checkpoint");
+    let err = r.count(usize::MAX >> 8, &|| "a count".into()).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "c.ck: byte 100: a count is 1152921504606846976, more than {}",
+            usize::MAX >> 8
+        )
     );
 }
 
