@@ -1020,6 +1020,28 @@ fn dumps_with_bad_rows_or_headers_are_refused_naming_line_and_item() {
     assert!(e.starts_with("c.txt:10: expected 5 columns, got 6"), "{e}");
 }
 
+/// A wall means file whose steps reach the end of the step numbers is refused naming the line
+/// after which no step can follow (the next step was once computed with an overflow: a panic in
+/// a debug build, a wrapped step in a release one).
+#[test]
+fn wall_means_at_the_end_of_the_step_numbers_are_refused_without_an_overflow() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("walls.txt");
+    let last = u64::MAX - 4095;
+    std::fs::write(&p, format!("{last} 0 0 0 0 0 0\n{last} 0 0 0 0 0 0\n")).unwrap();
+    let err = verdem::peers::inrun::read_wall_means(&p, 4096)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{}:2: column 1 (step): step {last}, expected none: the step numbers end (a mean \
+             every 4096 steps)",
+            p.display()
+        )
+    );
+}
+
 // ---- fuzzing ----------------------------------------------------------------------------
 
 /// One random change to a file's bytes.
@@ -1174,9 +1196,178 @@ fn apply(bytes: &[u8], m: &Mutation) -> Vec<u8> {
 
 /// A valid corpus file after one to four random mutations.
 fn mutated(seed: &'static str) -> impl Strategy<Value = Vec<u8>> {
-    let bytes = corpus_bytes(seed);
+    mutations_of(corpus_bytes(seed))
+}
+
+/// `bytes` after one to four random mutations.
+fn mutations_of(bytes: Vec<u8>) -> impl Strategy<Value = Vec<u8>> {
     prop::collection::vec(mutation(), 1..5)
         .prop_map(move |ms| ms.iter().fold(bytes.clone(), |b, m| apply(&b, m)))
+}
+
+/// Words of the tables verdem reads: numbers, the troublesome tokens, and words of their
+/// headers and items.
+const WORDS: [&str; 16] = [
+    "1",
+    "2",
+    "3",
+    "20",
+    "100",
+    "0.25",
+    "-2.5",
+    "1e-3",
+    "ITEM: TIMESTEP",
+    "ITEM: NUMBER OF ATOMS",
+    "ITEM: BOX BOUNDS pp pp ff",
+    "ITEM: ATOMS id type radius x y z vx vy vz omegax omegay omegaz",
+    "ITEM: ENTRIES",
+    "# time",
+    "Particles",
+    "xMin 0 xMax 4 yMin 0 yMax 2 zMin 0 zMax 5",
+];
+
+/// Arbitrary text: any characters, or (mostly) lines of the words of [`WORDS`] and
+/// [`TOKENS`] separated by commas or spaces, after one of the `headers` or none.
+fn arbitrary_text(headers: Vec<String>) -> impl Strategy<Value = Vec<u8>> {
+    let word = prop::sample::select([&WORDS[..], &TOKENS[..]].concat());
+    let line = (prop::collection::vec(word, 0..30), any::<bool>())
+        .prop_map(|(w, comma)| w.join(if comma { "," } else { " " }));
+    let head = prop::option::of(prop::sample::select(
+        [headers, vec![String::new()]].concat(),
+    ));
+    prop_oneof![
+        1 => any::<String>().prop_map(String::into_bytes),
+        4 => (head, prop::collection::vec(line, 0..40), any::<bool>()).prop_map(
+            |(head, lines, crlf)| {
+                let lines: Vec<String> = head.into_iter().chain(lines).collect();
+                lines.join(if crlf { "\r\n" } else { "\n" }).into_bytes()
+            }
+        ),
+    ]
+}
+
+/// What a reader of `text`, the file `file`, returned: a value, or an error that starts with
+/// the file's name and, when it names a line next, one the text has (or the one after).
+fn named<T, E: std::fmt::Display>(
+    r: Result<T, E>,
+    file: &str,
+    text: &[u8],
+) -> Result<(), TestCaseError> {
+    let Err(e) = r else { return Ok(()) };
+    let msg = e.to_string();
+    let rest = msg.strip_prefix(file).and_then(|m| m.strip_prefix(':'));
+    prop_assert!(rest.is_some(), "{msg:?} does not start with {file:?}:");
+    let digits: String = rest
+        .unwrap()
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    if !digits.is_empty() {
+        let line: usize = digits.parse().unwrap();
+        let lines = 1 + text.iter().filter(|&&b| b == b'\n').count();
+        prop_assert!((1..=lines + 1).contains(&line), "{msg:?}: {lines} lines");
+    }
+    Ok(())
+}
+
+thread_local! {
+    /// The folder of a test's files, one per test thread (a folder per case would spend the
+    /// fuzzing's time making and removing folders).
+    static FILES: tempfile::TempDir = tempfile::tempdir().unwrap();
+}
+
+/// [`named`] for a reader of the file `name`, whose text `text` is written to the folder of
+/// the test's files.
+fn named_file<T, E: std::fmt::Display>(
+    name: &str,
+    text: &[u8],
+    read: impl FnOnce(&Path) -> Result<T, E>,
+) -> Result<(), TestCaseError> {
+    let p = FILES.with(|d| d.path().join(name));
+    std::fs::write(&p, text).unwrap();
+    named(read(&p), &p.display().to_string(), text)
+}
+
+/// The seed of the table `name` that verdem's own commands read back, with its header: the
+/// diagnostics table of a run of the seed (its ledgers), an in-run error table, a wall means
+/// file of the peers' in-run averaging, a sweep's `bench.csv` or a trade-off table.
+fn table_seed(name: &str) -> Vec<u8> {
+    match name {
+        "diagnostics" => {
+            let dir = tempfile::tempdir().unwrap();
+            let mut e = small_engine();
+            let opts = verdem::run::RunOptions {
+                end_step: 20,
+                save_every: 5,
+                checkpoint_every: 0,
+                out_dir: dir.path().to_path_buf(),
+                name: "s".into(),
+                tag: checkpoint::tag(&small_case()),
+                progress: false,
+                write_saves: true,
+                vtk: false,
+                stop: None,
+            };
+            verdem::run::run(e.as_mut(), &opts, false).unwrap();
+            std::fs::read(verdem::run::diagnostics_path(dir.path(), "s")).unwrap()
+        }
+        "errors" => {
+            let mut t = String::from(
+                "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,method,\
+                 core_mean,core_se,core_degrees_of_freedom,core_trusted\n",
+            );
+            for c in verdem::analysis::cg::COLUMNS {
+                t.push_str(&format!("{c},1.5,2,2,10,9,blocks,0.25,1e-3,9,true\n"));
+            }
+            t.into_bytes()
+        }
+        "walls" => {
+            let rows: String = (1..6)
+                .map(|k| format!("{} 0 0 -1.5 0 0 1.5\n", 10 * k))
+                .collect();
+            ("# step fx fy fz fx fy fz\n".to_string() + &rows).into_bytes()
+        }
+        "bench" => (verdem::bench::csv(&[])
+            + "verdem,1,100,1e6,100 101,3480,1000,287.3,1,1,\n\
+               lammps,2,90,9e5,90 91,3480,1000,319.2,1.1,,\n")
+            .into_bytes(),
+        "tradeoff" => verdem::analysis::tradeoff::csv(&[]).into_bytes(),
+        _ => unreachable!("no seed table {name}"),
+    }
+}
+
+/// The seed table `name` ([`table_seed`]) after random mutations, or arbitrary text after its
+/// header.
+fn table(name: &'static str) -> impl Strategy<Value = Vec<u8>> {
+    let seed = table_seed(name);
+    let header = String::from_utf8_lossy(&seed)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    prop_oneof![mutations_of(seed), arbitrary_text(vec![header])]
+}
+
+/// The first line of the corpus file `name`.
+fn first_line(name: &str) -> String {
+    corpus_lines(name)[0].clone()
+}
+
+/// A checkpoint this verdem writes, as [`written_checkpoint`] writes it.
+fn checkpoint_bytes() -> Vec<u8> {
+    written_checkpoint(tempfile::tempdir().unwrap().path()).1
+}
+
+/// Arbitrary bytes, alone or after the magic and version of a checkpoint of format 4 (with a
+/// checksum) or 3 (without).
+fn arbitrary_checkpoint() -> impl Strategy<Value = Vec<u8>> {
+    let tail = prop::collection::vec(any::<u8>(), 0..4096);
+    prop_oneof![
+        tail.clone(),
+        tail.clone()
+            .prop_map(|t| [&b"\x89VERDEMK"[..], &4u64.to_le_bytes(), &t].concat()),
+        tail.prop_map(|t| [&b"VERDEMCK"[..], &3u64.to_le_bytes(), &t].concat()),
+    ]
 }
 
 /// Cases per reader: the whole fuzz set runs in a few seconds in release.
@@ -1201,45 +1392,113 @@ proptest! {
     #![proptest_config(fuzz_config())]
 
     #[test]
-    fn fuzz_data(b in mutated("small.data")) {
-        let _ = mercury::parse_data(&mut Lines::new("f", &b[..]));
+    fn fuzz_data(b in prop_oneof![
+        mutated("small.data"),
+        arbitrary_text(vec![first_line("small.data")])
+    ]) {
+        named(mercury::parse_data(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_fstat(b in prop_oneof![mutated("small.fstat"), mutated("mercury.fstat")]) {
-        let _ = mercury::parse_fstat(&mut Lines::new("f", &b[..]), None);
-        let _ = mercury::parse_fstat(&mut Lines::new("f", &b[..]), Some(20));
+    fn fuzz_fstat(b in prop_oneof![
+        mutated("small.fstat"),
+        mutated("mercury.fstat"),
+        arbitrary_text(vec![first_line("small.fstat")])
+    ]) {
+        named(mercury::parse_fstat(&mut Lines::new("f", &b[..]), None), "f", &b)?;
+        named(mercury::parse_fstat(&mut Lines::new("f", &b[..]), Some(20)), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_official(b in mutated("small.official.data")) {
-        let _ = official::parse(&mut Lines::new("f", &b[..]));
+    fn fuzz_official(b in prop_oneof![
+        mutated("small.official.data"),
+        arbitrary_text(vec![first_line("small.official.data")])
+    ]) {
+        named(official::parse(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_dumps(b in prop_oneof![mutated("lammps_dump.100.txt"), mutated("liggghts_dump.100.txt")]) {
-        let _ = dump::parse(&mut Lines::new("f", &b[..]));
+    fn fuzz_dumps(b in prop_oneof![
+        mutated("lammps_dump.100.txt"),
+        mutated("liggghts_dump.100.txt"),
+        arbitrary_text(vec![first_line("lammps_dump.100.txt")])
+    ]) {
+        named(dump::parse(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_dump_entries(b in prop_oneof![mutated("lammps_contacts.0.txt"), mutated("liggghts_contacts.0.txt")]) {
-        let _ = dump::parse_entries(&mut Lines::new("f", &b[..]), 6);
-        let _ = dump::parse_entries(&mut Lines::new("f", &b[..]), 5);
+    fn fuzz_dump_entries(b in prop_oneof![
+        mutated("lammps_contacts.0.txt"),
+        mutated("liggghts_contacts.0.txt"),
+        arbitrary_text(vec![first_line("lammps_contacts.0.txt")])
+    ]) {
+        named(dump::parse_entries(&mut Lines::new("f", &b[..]), 6), "f", &b)?;
+        named(dump::parse_entries(&mut Lines::new("f", &b[..]), 5), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_motion(b in mutated("motion.csv")) {
-        if let Ok(text) = io::utf8("f", b) {
-            let _ = verdem::kinematics::parse_motion("f", &text);
+    fn fuzz_motion(b in prop_oneof![
+        mutated("motion.csv"),
+        arbitrary_text(vec![first_line("motion.csv")])
+    ]) {
+        match io::utf8("f", b.clone()) {
+            Ok(text) => named(verdem::kinematics::parse_motion("f", &text), "f", &b)?,
+            Err(e) => named(Err::<(), _>(e), "f", &b)?,
         }
     }
 
     #[test]
-    fn fuzz_profiles_table(b in mutated("small.profiles.csv")) {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("t.csv");
-        std::fs::write(&p, &b).unwrap();
-        let _ = verdem::analysis::cg::table::Table::read(&p);
+    fn fuzz_forces(b in arbitrary_text(vec![verdem::kinematics::forces_csv(&[])])) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            named(verdem::kinematics::parse_forces_lines("f", &text), "f", &b)?;
+        }
+    }
+
+    #[test]
+    fn fuzz_csv_records(b in arbitrary_text(Vec::new())) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            for comments in [false, true] {
+                for r in io::csv_table::records("f", &text, comments) {
+                    named(r, "f", &b)?;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_profiles_table(b in prop_oneof![
+        mutated("small.profiles.csv"),
+        arbitrary_text(vec![first_line("small.profiles.csv")])
+    ]) {
+        named_file("t.csv", &b, verdem::analysis::cg::table::Table::read)?;
+    }
+
+    #[test]
+    fn fuzz_diagnostics_table(b in table("diagnostics")) {
+        named_file("s.diagnostics.csv", &b, io::diagnostics::read_ledgers)?;
+    }
+
+    #[test]
+    fn fuzz_inrun_errors_table(b in table("errors")) {
+        named_file("e.csv", &b, verdem::analysis::inrun::read_core_means)?;
+    }
+
+    #[test]
+    fn fuzz_wall_means(b in table("walls")) {
+        named_file("walls.txt", &b, |p| verdem::peers::inrun::read_wall_means(p, 10))?;
+    }
+
+    #[test]
+    fn fuzz_bench_table(b in table("bench")) {
+        named_file("bench.csv", &b, verdem::bench::cost_lines)?;
+    }
+
+    #[test]
+    fn fuzz_tradeoff_table(b in table("tradeoff")) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            let p = Path::new("tradeoff.csv");
+            named(verdem::analysis::tradeoff::read_csv(&text, p), "tradeoff.csv", &b)?;
+        }
     }
 }
 
@@ -1255,10 +1514,46 @@ proptest! {
         let _ = verdem::scene::build(&small_case(), Some(&p));
     }
 
+    /// A checkpoint of format 2 has no checksum: its mutations reach every field.
     #[test]
     fn fuzz_checkpoint(b in mutated("small.checkpoint")) {
         let mut e = small_engine();
         let tag = checkpoint::tag(&small_case());
-        let _ = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        named(checkpoint::restore("f", &b, e.as_mut(), &tag), "f", &[])?;
+    }
+
+    /// Any change to a checkpoint with a checksum is refused.
+    #[test]
+    fn fuzz_checkpoint_with_its_checksum((b, intact) in {
+        let intact = checkpoint_bytes();
+        mutations_of(intact.clone()).prop_map(move |b| (b, intact.clone()))
+    }) {
+        prop_assume!(b != intact);
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        let r = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        prop_assert!(r.is_err());
+        named(r, "f", &[])?;
+    }
+
+    /// Changes made behind the checksum's back (the checksum made again) reach every field.
+    #[test]
+    fn fuzz_checkpoint_resealed(b in {
+        let b = checkpoint_bytes();
+        mutations_of(b[..b.len() - 32].to_vec()).prop_map(|b| resealed(&b))
+    }) {
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        named(checkpoint::restore("f", &b, e.as_mut(), &tag), "f", &[])?;
+    }
+
+    /// Arbitrary bytes are no checkpoint.
+    #[test]
+    fn fuzz_checkpoint_arbitrary(b in arbitrary_checkpoint()) {
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        let r = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        prop_assert!(r.is_err());
+        named(r, "f", &[])?;
     }
 }
