@@ -1,7 +1,9 @@
 //! Bad data files: every reader refuses them with a message naming the file, the line and the
 //! field, through the command line as a user meets them (exit status 1, no panic, nothing
 //! non-finite written) and in-process; and every reader is fuzzed with random mutations of the
-//! valid files in `tests/corpus/` (see its README), returning Ok or Err and never panicking.
+//! valid files in `tests/corpus/` (see its README) and of the tables and checkpoints verdem
+//! writes, and with arbitrary text or bytes, returning Ok or an Err that names the file (and a
+//! line the file has), never panicking.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -1274,10 +1276,14 @@ thread_local! {
     /// The folder of a test's files, one per test thread (a folder per case would spend the
     /// fuzzing's time making and removing folders).
     static FILES: tempfile::TempDir = tempfile::tempdir().unwrap();
+    /// The seed's initial state, as [`small_engine`] builds it.
+    static SMALL_SNAPSHOT: verdem::state::Snapshot = small_engine().snapshot();
 }
 
 /// [`named`] for a reader of the file `name`, whose text `text` is written to the folder of
-/// the test's files.
+/// the test's files. The file is removed after it is read: a file written over by truncation
+/// is flushed to the disk when closed on some file systems (ext4), which would spend the
+/// fuzzing's time waiting for the disk.
 fn named_file<T, E: std::fmt::Display>(
     name: &str,
     text: &[u8],
@@ -1285,7 +1291,9 @@ fn named_file<T, E: std::fmt::Display>(
 ) -> Result<(), TestCaseError> {
     let p = FILES.with(|d| d.path().join(name));
     std::fs::write(&p, text).unwrap();
-    named(read(&p), &p.display().to_string(), text)
+    let r = read(&p);
+    std::fs::remove_file(&p).unwrap();
+    named(r, &p.display().to_string(), text)
 }
 
 /// The seed of the table `name` that verdem's own commands read back, with its header: the
@@ -1346,6 +1354,31 @@ fn table(name: &'static str) -> impl Strategy<Value = Vec<u8>> {
         .unwrap_or_default()
         .to_string();
     prop_oneof![mutations_of(seed), arbitrary_text(vec![header])]
+}
+
+/// Yade's files of step 0 of the seed as its script writes them: `save.0.txt` (radius x y z
+/// vx vy vz wx wy wz per body) and `contacts.0.txt` (the two bodies, from 0, the force on the
+/// first and its elastic spring).
+fn yade_seed(what: &str) -> Vec<u8> {
+    let s = small_engine().snapshot();
+    let p = &s.particles;
+    let mut t = String::from("# written by the seed\n");
+    match what {
+        "save" => {
+            for a in 0..p.len() {
+                let n = |v: &verdem::Vec3| format!("{} {} {}", v.x, v.y, v.z);
+                t.push_str(&format!(
+                    "{} {} {} {}\n",
+                    p.radius[a],
+                    n(&p.x[a]),
+                    n(&p.v[a]),
+                    n(&p.w[a])
+                ));
+            }
+        }
+        _ => t.push_str("16 0 0 0 -2.5 0 0 -1e-3\n17 18 0.25 0 0 1e-3 0 0\n"),
+    }
+    t.into_bytes()
 }
 
 /// The first line of the corpus file `name`.
@@ -1491,6 +1524,29 @@ proptest! {
     #[test]
     fn fuzz_bench_table(b in table("bench")) {
         named_file("bench.csv", &b, verdem::bench::cost_lines)?;
+    }
+
+    /// A peer's files, read through the peer as `verdem cross` reads them.
+    #[test]
+    fn fuzz_yade_frames(b in prop_oneof![
+        mutations_of(yade_seed("save")),
+        arbitrary_text(Vec::new())
+    ]) {
+        let yade = verdem::peers::by_name("yade").unwrap();
+        named_file("save.0.txt", &b, |p| yade.read_frame(p.parent().unwrap(), 0))?;
+    }
+
+    #[test]
+    fn fuzz_peer_contacts(b in prop_oneof![
+        mutations_of(yade_seed("contacts")),
+        mutated("lammps_contacts.0.txt"),
+        arbitrary_text(vec![first_line("lammps_contacts.0.txt")])
+    ]) {
+        let s = SMALL_SNAPSHOT.with(Clone::clone);
+        for peer in ["yade", "lammps", "liggghts"] {
+            let peer = verdem::peers::by_name(peer).unwrap();
+            named_file("contacts.0.txt", &b, |p| peer.read_contacts(p.parent().unwrap(), 0, &s))?;
+        }
     }
 
     #[test]
