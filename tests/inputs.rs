@@ -663,7 +663,7 @@ fn a_checkpoint_is_not_text_and_resumes_bit_for_bit_with_its_run_record() {
 /// Every single bit of the file flipped in turn, in its header (magic, version, tag, step,
 /// time, dt, counts), its particles, its contacts' histories and forces, its ledgers, its
 /// observer's state and its checksum, and the file cut at every byte: each is refused naming
-/// the file, before anything is restored.
+/// the file, before anything is restored, in-process and by `verdem run --resume`.
 #[test]
 fn a_checkpoint_with_any_bit_flipped_or_cut_anywhere_is_refused_before_it_is_restored() {
     let dir = tempfile::tempdir().unwrap();
@@ -722,6 +722,14 @@ fn a_checkpoint_with_any_bit_flipped_or_cut_anywhere_is_refused_before_it_is_res
         );
     }
     assert!(untouched == (state_bits(&e.snapshot()), e.flows()));
+    // as `verdem run --resume` meets it
+    let text = std::fs::read_to_string(corpus("small.toml")).unwrap();
+    resume_refused(
+        &text,
+        &corpus("small.data"),
+        &p,
+        &[&name, "refused, a corrupted checkpoint", &short_hex(sum)],
+    );
 }
 
 /// A checkpoint of format version 3 (no checksum) still resumes bit for bit, and says that it
