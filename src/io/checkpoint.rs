@@ -69,8 +69,9 @@ pub struct Resumed {
 }
 
 impl Resumed {
-    /// What the checkpoint lacks of its run record, one sentence each (for the user; the
-    /// observer's state is its owner's to judge).
+    /// What the checkpoint lacks, one sentence each (for the user): a checksum (format versions
+    /// 2 and 3), and of its run record the ledgers (the observer's state is its owner's to
+    /// judge).
     pub fn lacks(&self) -> Vec<String> {
         let mut out = Vec::new();
         if self.version <= WITHOUT_CHECKSUM {
