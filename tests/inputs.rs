@@ -1,7 +1,9 @@
 //! Bad data files: every reader refuses them with a message naming the file, the line and the
 //! field, through the command line as a user meets them (exit status 1, no panic, nothing
 //! non-finite written) and in-process; and every reader is fuzzed with random mutations of the
-//! valid files in `tests/corpus/` (see its README), returning Ok or Err and never panicking.
+//! valid files in `tests/corpus/` (see its README) and of the tables and checkpoints verdem
+//! writes, and with arbitrary text or bytes, returning Ok or an Err that names the file (and a
+//! line the file has), never panicking.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -508,7 +510,7 @@ fn a_checkpoint_of_another_case_law_step_count_or_version_is_refused_saying_what
         &[
             "small_v1.checkpoint",
             "checkpoint format version 1",
-            "reads version 2",
+            "reads versions 2 to 4",
         ],
     );
     let cut = dir.path().join("cut.checkpoint");
@@ -573,6 +575,247 @@ fn a_checkpoint_with_other_history_words_or_a_non_finite_number_is_refused_namin
     assert_eq!(
         checkpoint::restore("c.ck", &bytes, e.as_mut(), &tag).unwrap(),
         10
+    );
+}
+
+/// The checkpoint this verdem writes of the seed's run at step 10, with a run record (the
+/// ledgers with their last save's reading, and an observer's state), and the engine it holds.
+fn written_checkpoint(dir: &Path) -> (PathBuf, Vec<u8>, checkpoint::RunRecord, Box<dyn Engine>) {
+    let mut e = small_engine();
+    e.advance(10).unwrap();
+    let record = checkpoint::RunRecord {
+        ledgers: Some(checkpoint::Ledgers {
+            flows: e.flows(),
+            last_save: Some(e.ledger()),
+        }),
+        observer: Some(b"the observer's sums".to_vec()),
+    };
+    let p = dir.join("c.checkpoint");
+    let tag = checkpoint::tag(&small_case());
+    checkpoint::write_run(&p, &e.snapshot(), e.params().dt, &tag, &record).unwrap();
+    (p.clone(), std::fs::read(&p).unwrap(), record, e)
+}
+
+/// The bits of everything a checkpoint holds of `s`: step, time, and every number of its
+/// particles and contacts.
+fn state_bits(s: &verdem::state::Snapshot) -> Vec<u64> {
+    let p = &s.particles;
+    let mut out = vec![s.step, s.time.to_bits()];
+    let put = |out: &mut Vec<u64>, v: &verdem::Vec3| out.extend(v.iter().map(|x| x.to_bits()));
+    for a in 0..p.len() {
+        for v in [&p.x[a], &p.v[a], &p.w[a], &p.f[a], &p.t[a]] {
+            put(&mut out, v);
+        }
+    }
+    for c in &s.contacts {
+        let f = &c.force;
+        for v in [&f.f, &f.torque_p, &f.torque_i] {
+            put(&mut out, v);
+        }
+        out.extend([u64::from(c.p), u64::from(c.i), f.fn_signed.to_bits()]);
+        out.extend(c.history.iter().map(|w| w.to_bits()));
+    }
+    out
+}
+
+/// The SHA-256 digest of `bytes`.
+fn sha256(bytes: &[u8]) -> Vec<u8> {
+    use sha2::Digest;
+    sha2::Sha256::digest(bytes).to_vec()
+}
+
+/// The first 8 bytes of `digest` in hex.
+fn short_hex(digest: &[u8]) -> String {
+    digest[..8].iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+fn a_checkpoint_is_not_text_and_resumes_bit_for_bit_with_its_run_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, bytes, record, mut e) = written_checkpoint(dir.path());
+    assert_eq!(bytes[0], 0x89);
+    assert!(std::str::from_utf8(&bytes).is_err());
+    let before = e.snapshot();
+    assert!(
+        !before.contacts.is_empty() && !before.contacts[0].history.is_empty(),
+        "the checkpoint holds contacts with their histories"
+    );
+    let tag = checkpoint::tag(&small_case());
+    let mut resumed = small_engine();
+    let r = checkpoint::read_run(&p, resumed.as_mut(), &tag).unwrap();
+    assert_eq!((r.step, r.version), (10, checkpoint::FORMAT_VERSION));
+    assert_eq!(r.record, record);
+    assert!(r.lacks().is_empty(), "{:?}", r.lacks());
+    assert_eq!(state_bits(&resumed.snapshot()), state_bits(&before));
+    assert_eq!(
+        io::hash::state_hash(&resumed.snapshot()),
+        io::hash::state_hash(&before)
+    );
+    assert_eq!(resumed.flows(), e.flows());
+    e.advance(20).unwrap();
+    resumed.advance(20).unwrap();
+    assert_eq!(
+        io::hash::state_hash(&resumed.snapshot()),
+        io::hash::state_hash(&e.snapshot())
+    );
+}
+
+/// Every single bit of the file flipped in turn, in its header (magic, version, tag, step,
+/// time, dt, counts), its particles, its contacts' histories and forces, its ledgers, its
+/// observer's state and its checksum, and the file cut at every byte: each is refused naming
+/// the file, before anything is restored, in-process and by `verdem run --resume`.
+#[test]
+fn a_checkpoint_with_any_bit_flipped_or_cut_anywhere_is_refused_before_it_is_restored() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, bytes, _, _) = written_checkpoint(dir.path());
+    let name = p.display().to_string();
+    let tag = checkpoint::tag(&small_case());
+    let mut e = small_engine();
+    let untouched = (state_bits(&e.snapshot()), e.flows());
+    let (body, sum) = bytes.split_at(bytes.len() - 32);
+    assert_eq!(sum, sha256(body));
+    for k in 0..bytes.len() {
+        for bit in 0..8 {
+            let mut b = bytes.clone();
+            b[k] ^= 1 << bit;
+            let err = checkpoint::restore(&name, &b, e.as_mut(), &tag)
+                .unwrap_err()
+                .to_string();
+            let expect = if k < 8 {
+                format!("{name}: not a verdem checkpoint")
+            } else {
+                format!("{name}: refused, a corrupted checkpoint")
+            };
+            assert!(err.starts_with(&expect), "byte {k} bit {bit}: {err}");
+        }
+    }
+    // the first particle's x: magic, version, tag length, tag, step, time, dt and two counts
+    let x_at = 8 + 8 + 8 + tag.len() + 8 * 5;
+    let mut b = bytes.clone();
+    b[x_at + 3] ^= 0x10;
+    std::fs::write(&p, &b).unwrap();
+    let err = checkpoint::read(&p, e.as_mut(), &tag)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{name}: refused, a corrupted checkpoint (changed or truncated since it was \
+             written): its checksum says SHA-256 {}…, its {} bytes before it have {}…",
+            short_hex(sum),
+            body.len(),
+            short_hex(&sha256(&b[..body.len()]))
+        )
+    );
+    for len in 0..bytes.len() {
+        let err = checkpoint::restore(&name, &bytes[..len], e.as_mut(), &tag)
+            .unwrap_err()
+            .to_string();
+        let expect = match len {
+            0..8 => "not a verdem checkpoint",
+            8..32 => "checkpoint truncated",
+            _ => "refused, a corrupted checkpoint",
+        };
+        assert!(
+            err.starts_with(&format!("{name}: {expect}")),
+            "cut at {len}: {err}"
+        );
+    }
+    assert!(untouched == (state_bits(&e.snapshot()), e.flows()));
+    // as `verdem run --resume` meets it
+    let text = std::fs::read_to_string(corpus("small.toml")).unwrap();
+    resume_refused(
+        &text,
+        &corpus("small.data"),
+        &p,
+        &[&name, "refused, a corrupted checkpoint", &short_hex(sum)],
+    );
+}
+
+/// A checkpoint of format version 3 (no checksum) still resumes bit for bit, and says that it
+/// carries no checksum; one of format version 2 says it too, beside its lack of ledgers.
+#[test]
+fn a_checkpoint_of_an_older_format_resumes_saying_it_carries_no_checksum() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, bytes, record, e) = written_checkpoint(dir.path());
+    // version 3: the magic of versions 2 and 3, and no checksum
+    let mut v3 = b"VERDEMCK".to_vec();
+    v3.extend_from_slice(&3u64.to_le_bytes());
+    v3.extend_from_slice(&bytes[16..bytes.len() - 32]);
+    let tag = checkpoint::tag(&small_case());
+    let mut resumed = small_engine();
+    let r = checkpoint::restore_run("c3.ck", &v3, resumed.as_mut(), &tag).unwrap();
+    assert_eq!((r.version, &r.record), (3, &record));
+    assert_eq!(state_bits(&resumed.snapshot()), state_bits(&e.snapshot()));
+    assert_eq!(
+        r.lacks(),
+        [
+            "a checkpoint of format version 3 carries no checksum: a change to it since it was \
+          written (a flipped bit) cannot be detected"
+        ]
+    );
+    let r = checkpoint::read_run(&corpus("small.checkpoint"), resumed.as_mut(), &tag).unwrap();
+    let lacks = r.lacks();
+    assert_eq!(lacks.len(), 2, "{lacks:?}");
+    assert!(lacks[0].starts_with("a checkpoint of format version 2 carries no checksum"));
+    assert!(lacks[1].starts_with("a checkpoint of format version 2 holds no ledgers"));
+}
+
+/// `bytes` with its checksum made again for its changed body.
+fn resealed(bytes: &[u8]) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    b.extend_from_slice(&sha256(bytes));
+    b
+}
+
+#[test]
+fn an_absurd_count_in_a_checkpoint_is_refused_before_anything_is_reserved_for_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, bytes, record, _) = written_checkpoint(dir.path());
+    let body = &bytes[..bytes.len() - 32];
+    let tag = checkpoint::tag(&small_case());
+    let huge = (1u64 << 60).to_le_bytes();
+    let contacts_at = 8 + 8 + 8 + tag.len() + 8 * 5 + 20 * 15 * 8;
+    let observer_at = body.len() - record.observer.as_ref().unwrap().len() - 8;
+    let len = body.len();
+    for (at, expect) in [
+        (
+            16,
+            format!("c.ck: checkpoint truncated at byte 24 (of {len}; 1152921504606846976 more"),
+        ),
+        (
+            contacts_at,
+            format!(
+                "c.ck: byte {contacts_at}: the contact count is 1152921504606846976, more than"
+            ),
+        ),
+        (
+            observer_at,
+            format!(
+                "c.ck: byte {observer_at}: the observer's state length is 1152921504606846976, \
+                 more than {len}"
+            ),
+        ),
+    ] {
+        let mut b = body.to_vec();
+        b[at..at + 8].copy_from_slice(&huge);
+        let mut e = small_engine();
+        let err = checkpoint::restore("c.ck", &resealed(&b), e.as_mut(), &tag)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with(&expect),
+            "{expect:?} is not the start of {err:?}"
+        );
+    }
+    let mut r = checkpoint::Reader::new("c.ck", &huge, 100, "checkpoint");
+    let err = r.count(usize::MAX >> 8, &|| "a count".into()).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "c.ck: byte 100: a count is 1152921504606846976, more than {}",
+            usize::MAX >> 8
+        )
     );
 }
 
@@ -787,6 +1030,28 @@ fn dumps_with_bad_rows_or_headers_are_refused_naming_line_and_item() {
     assert!(e.starts_with("c.txt:10: expected 5 columns, got 6"), "{e}");
 }
 
+/// A wall means file whose steps reach the end of the step numbers is refused naming the line
+/// after which no step can follow (the next step was once computed with an overflow: a panic in
+/// a debug build, a wrapped step in a release one).
+#[test]
+fn wall_means_at_the_end_of_the_step_numbers_are_refused_without_an_overflow() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("walls.txt");
+    let last = u64::MAX - 4095;
+    std::fs::write(&p, format!("{last} 0 0 0 0 0 0\n{last} 0 0 0 0 0 0\n")).unwrap();
+    let err = verdem::peers::inrun::read_wall_means(&p, 4096)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{}:2: column 1 (step): step {last}, expected none: the step numbers end (a mean \
+             every 4096 steps)",
+            p.display()
+        )
+    );
+}
+
 // ---- fuzzing ----------------------------------------------------------------------------
 
 /// One random change to a file's bytes.
@@ -941,9 +1206,209 @@ fn apply(bytes: &[u8], m: &Mutation) -> Vec<u8> {
 
 /// A valid corpus file after one to four random mutations.
 fn mutated(seed: &'static str) -> impl Strategy<Value = Vec<u8>> {
-    let bytes = corpus_bytes(seed);
+    mutations_of(corpus_bytes(seed))
+}
+
+/// `bytes` after one to four random mutations.
+fn mutations_of(bytes: Vec<u8>) -> impl Strategy<Value = Vec<u8>> {
     prop::collection::vec(mutation(), 1..5)
         .prop_map(move |ms| ms.iter().fold(bytes.clone(), |b, m| apply(&b, m)))
+}
+
+/// Words of the tables verdem reads: numbers, the troublesome tokens, and words of their
+/// headers and items.
+const WORDS: [&str; 16] = [
+    "1",
+    "2",
+    "3",
+    "20",
+    "100",
+    "0.25",
+    "-2.5",
+    "1e-3",
+    "ITEM: TIMESTEP",
+    "ITEM: NUMBER OF ATOMS",
+    "ITEM: BOX BOUNDS pp pp ff",
+    "ITEM: ATOMS id type radius x y z vx vy vz omegax omegay omegaz",
+    "ITEM: ENTRIES",
+    "# time",
+    "Particles",
+    "xMin 0 xMax 4 yMin 0 yMax 2 zMin 0 zMax 5",
+];
+
+/// Arbitrary text: any characters, or (mostly) lines of the words of [`WORDS`] and
+/// [`TOKENS`] separated by commas or spaces, after one of the `headers` or none.
+fn arbitrary_text(headers: Vec<String>) -> impl Strategy<Value = Vec<u8>> {
+    let word = prop::sample::select([&WORDS[..], &TOKENS[..]].concat());
+    let line = (prop::collection::vec(word, 0..30), any::<bool>())
+        .prop_map(|(w, comma)| w.join(if comma { "," } else { " " }));
+    let head = prop::option::of(prop::sample::select(
+        [headers, vec![String::new()]].concat(),
+    ));
+    prop_oneof![
+        1 => any::<String>().prop_map(String::into_bytes),
+        4 => (head, prop::collection::vec(line, 0..40), any::<bool>()).prop_map(
+            |(head, lines, crlf)| {
+                let lines: Vec<String> = head.into_iter().chain(lines).collect();
+                lines.join(if crlf { "\r\n" } else { "\n" }).into_bytes()
+            }
+        ),
+    ]
+}
+
+/// What a reader of `text`, the file `file`, returned: a value, or an error that starts with
+/// the file's name and, when it names a line next, one the text has (or the one after).
+fn named<T, E: std::fmt::Display>(
+    r: Result<T, E>,
+    file: &str,
+    text: &[u8],
+) -> Result<(), TestCaseError> {
+    let Err(e) = r else { return Ok(()) };
+    let msg = e.to_string();
+    let rest = msg.strip_prefix(file).and_then(|m| m.strip_prefix(':'));
+    prop_assert!(rest.is_some(), "{msg:?} does not start with {file:?}:");
+    let digits: String = rest
+        .unwrap()
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    if !digits.is_empty() {
+        let line: usize = digits.parse().unwrap();
+        let lines = 1 + text.iter().filter(|&&b| b == b'\n').count();
+        prop_assert!((1..=lines + 1).contains(&line), "{msg:?}: {lines} lines");
+    }
+    Ok(())
+}
+
+thread_local! {
+    /// The folder of a test's files, one per test thread (a folder per case would spend the
+    /// fuzzing's time making and removing folders).
+    static FILES: tempfile::TempDir = tempfile::tempdir().unwrap();
+    /// The seed's initial state, as [`small_engine`] builds it.
+    static SMALL_SNAPSHOT: verdem::state::Snapshot = small_engine().snapshot();
+}
+
+/// [`named`] for a reader of the file `name`, whose text `text` is written to the folder of
+/// the test's files. The file is removed after it is read: a file written over by truncation
+/// is flushed to the disk when closed on some file systems (ext4), which would spend the
+/// fuzzing's time waiting for the disk.
+fn named_file<T, E: std::fmt::Display>(
+    name: &str,
+    text: &[u8],
+    read: impl FnOnce(&Path) -> Result<T, E>,
+) -> Result<(), TestCaseError> {
+    let p = FILES.with(|d| d.path().join(name));
+    std::fs::write(&p, text).unwrap();
+    let r = read(&p);
+    std::fs::remove_file(&p).unwrap();
+    named(r, &p.display().to_string(), text)
+}
+
+/// The seed of the table `name` that verdem's own commands read back, with its header: the
+/// diagnostics table of a run of the seed (its ledgers), an in-run error table, a wall means
+/// file of the peers' in-run averaging, a sweep's `bench.csv` or a trade-off table.
+fn table_seed(name: &str) -> Vec<u8> {
+    match name {
+        "diagnostics" => {
+            let dir = tempfile::tempdir().unwrap();
+            let mut e = small_engine();
+            let opts = verdem::run::RunOptions {
+                end_step: 20,
+                save_every: 5,
+                checkpoint_every: 0,
+                out_dir: dir.path().to_path_buf(),
+                name: "s".into(),
+                tag: checkpoint::tag(&small_case()),
+                progress: false,
+                write_saves: true,
+                vtk: false,
+                stop: None,
+            };
+            verdem::run::run(e.as_mut(), &opts, false).unwrap();
+            std::fs::read(verdem::run::diagnostics_path(dir.path(), "s")).unwrap()
+        }
+        "errors" => {
+            let mut t = String::from(
+                "column,tau_measured,tau_reference,tau_used,blocks,degrees_of_freedom,method,\
+                 core_mean,core_se,core_degrees_of_freedom,core_trusted\n",
+            );
+            for c in verdem::analysis::cg::COLUMNS {
+                t.push_str(&format!("{c},1.5,2,2,10,9,blocks,0.25,1e-3,9,true\n"));
+            }
+            t.into_bytes()
+        }
+        "walls" => {
+            let rows: String = (1..6)
+                .map(|k| format!("{} 0 0 -1.5 0 0 1.5\n", 10 * k))
+                .collect();
+            ("# step fx fy fz fx fy fz\n".to_string() + &rows).into_bytes()
+        }
+        "bench" => (verdem::bench::csv(&[])
+            + "verdem,1,100,1e6,100 101,3480,1000,287.3,1,1,\n\
+               lammps,2,90,9e5,90 91,3480,1000,319.2,1.1,,\n")
+            .into_bytes(),
+        "tradeoff" => verdem::analysis::tradeoff::csv(&[]).into_bytes(),
+        _ => unreachable!("no seed table {name}"),
+    }
+}
+
+/// The seed table `name` ([`table_seed`]) after random mutations, or arbitrary text after its
+/// header.
+fn table(name: &'static str) -> impl Strategy<Value = Vec<u8>> {
+    let seed = table_seed(name);
+    let header = String::from_utf8_lossy(&seed)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    prop_oneof![mutations_of(seed), arbitrary_text(vec![header])]
+}
+
+/// Yade's files of step 0 of the seed as its script writes them: `save.0.txt` (radius x y z
+/// vx vy vz wx wy wz per body) and `contacts.0.txt` (the two bodies, from 0, the force on the
+/// first and its elastic spring).
+fn yade_seed(what: &str) -> Vec<u8> {
+    let s = small_engine().snapshot();
+    let p = &s.particles;
+    let mut t = String::from("# written by the seed\n");
+    match what {
+        "save" => {
+            for a in 0..p.len() {
+                let n = |v: &verdem::Vec3| format!("{} {} {}", v.x, v.y, v.z);
+                t.push_str(&format!(
+                    "{} {} {} {}\n",
+                    p.radius[a],
+                    n(&p.x[a]),
+                    n(&p.v[a]),
+                    n(&p.w[a])
+                ));
+            }
+        }
+        _ => t.push_str("16 0 0 0 -2.5 0 0 -1e-3\n17 18 0.25 0 0 1e-3 0 0\n"),
+    }
+    t.into_bytes()
+}
+
+/// The first line of the corpus file `name`.
+fn first_line(name: &str) -> String {
+    corpus_lines(name)[0].clone()
+}
+
+/// A checkpoint this verdem writes, as [`written_checkpoint`] writes it.
+fn checkpoint_bytes() -> Vec<u8> {
+    written_checkpoint(tempfile::tempdir().unwrap().path()).1
+}
+
+/// Arbitrary bytes, alone or after the magic and version of a checkpoint of format 4 (with a
+/// checksum) or 3 (without).
+fn arbitrary_checkpoint() -> impl Strategy<Value = Vec<u8>> {
+    let tail = prop::collection::vec(any::<u8>(), 0..4096);
+    prop_oneof![
+        tail.clone(),
+        tail.clone()
+            .prop_map(|t| [&b"\x89VERDEMK"[..], &4u64.to_le_bytes(), &t].concat()),
+        tail.prop_map(|t| [&b"VERDEMCK"[..], &3u64.to_le_bytes(), &t].concat()),
+    ]
 }
 
 /// Cases per reader: the whole fuzz set runs in a few seconds in release.
@@ -968,45 +1433,136 @@ proptest! {
     #![proptest_config(fuzz_config())]
 
     #[test]
-    fn fuzz_data(b in mutated("small.data")) {
-        let _ = mercury::parse_data(&mut Lines::new("f", &b[..]));
+    fn fuzz_data(b in prop_oneof![
+        mutated("small.data"),
+        arbitrary_text(vec![first_line("small.data")])
+    ]) {
+        named(mercury::parse_data(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_fstat(b in prop_oneof![mutated("small.fstat"), mutated("mercury.fstat")]) {
-        let _ = mercury::parse_fstat(&mut Lines::new("f", &b[..]), None);
-        let _ = mercury::parse_fstat(&mut Lines::new("f", &b[..]), Some(20));
+    fn fuzz_fstat(b in prop_oneof![
+        mutated("small.fstat"),
+        mutated("mercury.fstat"),
+        arbitrary_text(vec![first_line("small.fstat")])
+    ]) {
+        named(mercury::parse_fstat(&mut Lines::new("f", &b[..]), None), "f", &b)?;
+        named(mercury::parse_fstat(&mut Lines::new("f", &b[..]), Some(20)), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_official(b in mutated("small.official.data")) {
-        let _ = official::parse(&mut Lines::new("f", &b[..]));
+    fn fuzz_official(b in prop_oneof![
+        mutated("small.official.data"),
+        arbitrary_text(vec![first_line("small.official.data")])
+    ]) {
+        named(official::parse(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_dumps(b in prop_oneof![mutated("lammps_dump.100.txt"), mutated("liggghts_dump.100.txt")]) {
-        let _ = dump::parse(&mut Lines::new("f", &b[..]));
+    fn fuzz_dumps(b in prop_oneof![
+        mutated("lammps_dump.100.txt"),
+        mutated("liggghts_dump.100.txt"),
+        arbitrary_text(vec![first_line("lammps_dump.100.txt")])
+    ]) {
+        named(dump::parse(&mut Lines::new("f", &b[..])), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_dump_entries(b in prop_oneof![mutated("lammps_contacts.0.txt"), mutated("liggghts_contacts.0.txt")]) {
-        let _ = dump::parse_entries(&mut Lines::new("f", &b[..]), 6);
-        let _ = dump::parse_entries(&mut Lines::new("f", &b[..]), 5);
+    fn fuzz_dump_entries(b in prop_oneof![
+        mutated("lammps_contacts.0.txt"),
+        mutated("liggghts_contacts.0.txt"),
+        arbitrary_text(vec![first_line("lammps_contacts.0.txt")])
+    ]) {
+        named(dump::parse_entries(&mut Lines::new("f", &b[..]), 6), "f", &b)?;
+        named(dump::parse_entries(&mut Lines::new("f", &b[..]), 5), "f", &b)?;
     }
 
     #[test]
-    fn fuzz_motion(b in mutated("motion.csv")) {
-        if let Ok(text) = io::utf8("f", b) {
-            let _ = verdem::kinematics::parse_motion("f", &text);
+    fn fuzz_motion(b in prop_oneof![
+        mutated("motion.csv"),
+        arbitrary_text(vec![first_line("motion.csv")])
+    ]) {
+        match io::utf8("f", b.clone()) {
+            Ok(text) => named(verdem::kinematics::parse_motion("f", &text), "f", &b)?,
+            Err(e) => named(Err::<(), _>(e), "f", &b)?,
         }
     }
 
     #[test]
-    fn fuzz_profiles_table(b in mutated("small.profiles.csv")) {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("t.csv");
-        std::fs::write(&p, &b).unwrap();
-        let _ = verdem::analysis::cg::table::Table::read(&p);
+    fn fuzz_forces(b in arbitrary_text(vec![verdem::kinematics::forces_csv(&[])])) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            named(verdem::kinematics::parse_forces_lines("f", &text), "f", &b)?;
+        }
+    }
+
+    #[test]
+    fn fuzz_csv_records(b in arbitrary_text(Vec::new())) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            for comments in [false, true] {
+                for r in io::csv_table::records("f", &text, comments) {
+                    named(r, "f", &b)?;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_profiles_table(b in prop_oneof![
+        mutated("small.profiles.csv"),
+        arbitrary_text(vec![first_line("small.profiles.csv")])
+    ]) {
+        named_file("t.csv", &b, verdem::analysis::cg::table::Table::read)?;
+    }
+
+    #[test]
+    fn fuzz_diagnostics_table(b in table("diagnostics")) {
+        named_file("s.diagnostics.csv", &b, io::diagnostics::read_ledgers)?;
+    }
+
+    #[test]
+    fn fuzz_inrun_errors_table(b in table("errors")) {
+        named_file("e.csv", &b, verdem::analysis::inrun::read_core_means)?;
+    }
+
+    #[test]
+    fn fuzz_wall_means(b in table("walls")) {
+        named_file("walls.txt", &b, |p| verdem::peers::inrun::read_wall_means(p, 10))?;
+    }
+
+    #[test]
+    fn fuzz_bench_table(b in table("bench")) {
+        named_file("bench.csv", &b, verdem::bench::cost_lines)?;
+    }
+
+    /// A peer's files, read through the peer as `verdem cross` reads them.
+    #[test]
+    fn fuzz_yade_frames(b in prop_oneof![
+        mutations_of(yade_seed("save")),
+        arbitrary_text(Vec::new())
+    ]) {
+        let yade = verdem::peers::by_name("yade").unwrap();
+        named_file("save.0.txt", &b, |p| yade.read_frame(p.parent().unwrap(), 0))?;
+    }
+
+    #[test]
+    fn fuzz_peer_contacts(b in prop_oneof![
+        mutations_of(yade_seed("contacts")),
+        mutated("lammps_contacts.0.txt"),
+        arbitrary_text(vec![first_line("lammps_contacts.0.txt")])
+    ]) {
+        let s = SMALL_SNAPSHOT.with(Clone::clone);
+        for peer in ["yade", "lammps", "liggghts"] {
+            let peer = verdem::peers::by_name(peer).unwrap();
+            named_file("contacts.0.txt", &b, |p| peer.read_contacts(p.parent().unwrap(), 0, &s))?;
+        }
+    }
+
+    #[test]
+    fn fuzz_tradeoff_table(b in table("tradeoff")) {
+        if let Ok(text) = String::from_utf8(b.clone()) {
+            let p = Path::new("tradeoff.csv");
+            named(verdem::analysis::tradeoff::read_csv(&text, p), "tradeoff.csv", &b)?;
+        }
     }
 }
 
@@ -1022,10 +1578,46 @@ proptest! {
         let _ = verdem::scene::build(&small_case(), Some(&p));
     }
 
+    /// A checkpoint of format 2 has no checksum: its mutations reach every field.
     #[test]
     fn fuzz_checkpoint(b in mutated("small.checkpoint")) {
         let mut e = small_engine();
         let tag = checkpoint::tag(&small_case());
-        let _ = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        named(checkpoint::restore("f", &b, e.as_mut(), &tag), "f", &[])?;
+    }
+
+    /// Any change to a checkpoint with a checksum is refused.
+    #[test]
+    fn fuzz_checkpoint_with_its_checksum((b, intact) in {
+        let intact = checkpoint_bytes();
+        mutations_of(intact.clone()).prop_map(move |b| (b, intact.clone()))
+    }) {
+        prop_assume!(b != intact);
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        let r = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        prop_assert!(r.is_err());
+        named(r, "f", &[])?;
+    }
+
+    /// Changes made behind the checksum's back (the checksum made again) reach every field.
+    #[test]
+    fn fuzz_checkpoint_resealed(b in {
+        let b = checkpoint_bytes();
+        mutations_of(b[..b.len() - 32].to_vec()).prop_map(|b| resealed(&b))
+    }) {
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        named(checkpoint::restore("f", &b, e.as_mut(), &tag), "f", &[])?;
+    }
+
+    /// Arbitrary bytes are no checkpoint.
+    #[test]
+    fn fuzz_checkpoint_arbitrary(b in arbitrary_checkpoint()) {
+        let mut e = small_engine();
+        let tag = checkpoint::tag(&small_case());
+        let r = checkpoint::restore("f", &b, e.as_mut(), &tag);
+        prop_assert!(r.is_err());
+        named(r, "f", &[])?;
     }
 }

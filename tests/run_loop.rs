@@ -85,13 +85,14 @@ fn checkpoint_of_another_case_is_refused() {
     let mut other = engine(&case, None, Overrides::default());
     let err = verdem::io::checkpoint::read(&p, other.as_mut(), "other:3480").unwrap_err();
     assert!(err.to_string().contains("checkpoint of case"), "{err}");
-    // a truncated checkpoint says where it ends; a short foreign file is no checkpoint
+    // a truncated checkpoint fails its checksum; a short foreign file is no checkpoint
     let bytes = std::fs::read(&p).unwrap();
     let cut = dir.path().join("cut.checkpoint");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
     let err = verdem::io::checkpoint::read(&cut, other.as_mut(), "q:3480").unwrap_err();
     assert!(
-        err.to_string().contains("checkpoint truncated at byte"),
+        err.to_string()
+            .contains("cut.checkpoint: refused, a corrupted checkpoint"),
         "{err}"
     );
     for junk in [&b"garbage"[..], b"garbage and more"] {

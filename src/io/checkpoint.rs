@@ -3,27 +3,38 @@
 //! run loop needs to write the same files as a run never stopped (the ledgers' flows and their
 //! reading at the last save, and the state of its observer, the in-run averaging), written
 //! atomically in one file. The pair list itself is rebuilt on resume; results do not depend on
-//! when it is.
+//! when it is. A SHA-256 checksum of the file closes it, so that a checkpoint changed since it
+//! was written (a flipped bit, a cut) is refused before anything is restored.
 
 use std::path::Path;
 
 use anyhow::{bail, Context};
+use sha2::{Digest, Sha256};
 
 use crate::contact::PairForce;
 use crate::state::{Contact, Snapshot};
 use crate::step::{Engine, Flows, Reading};
 use crate::Vec3;
 
-/// The first 8 bytes of every checkpoint; the format version follows.
-const MAGIC: &[u8; 8] = b"VERDEMCK";
+/// The first 8 bytes of every checkpoint from format version 4 on; the format version follows.
+/// Its first byte, 0x89, cannot start a UTF-8 character, so that a checkpoint is never valid
+/// UTF-8 text by accident, which [`crate::io::atomic::write`] would check for non-finite number
+/// tokens.
+const MAGIC: &[u8; 8] = b"\x89VERDEMK";
+/// The first 8 bytes of the checkpoints of format versions 2 and 3, which had no checksum.
+const MAGIC_UNSUMMED: &[u8; 8] = b"VERDEMCK";
 /// The first 8 bytes of the checkpoints of format version 1, which had no version field.
 const MAGIC_V1: &[u8; 8] = b"VERDEMC1";
-/// The layout this verdem writes; it also reads version 2, which had no run record
-/// ([`RunRecord`]).
-pub const FORMAT_VERSION: u64 = 3;
+/// The layout this verdem writes; it also reads versions 2, which had no run record
+/// ([`RunRecord`]), and 3, which had no checksum (both with a warning: [`Resumed::lacks`]).
+pub const FORMAT_VERSION: u64 = 4;
 
 /// The last format version without a run record.
 const WITHOUT_RECORD: u64 = 2;
+/// The last format version without a checksum.
+const WITHOUT_CHECKSUM: u64 = 3;
+/// The length of the checksum that closes a checkpoint (a SHA-256 digest, bytes).
+const CHECKSUM_LEN: usize = 32;
 
 /// What a run keeps beside the state, written with it from format version 3 on, so that a
 /// resumed run writes the same diagnostics and in-run profiles as a run never stopped.
@@ -58,10 +69,18 @@ pub struct Resumed {
 }
 
 impl Resumed {
-    /// What the checkpoint lacks of its run record, one sentence each (for the user; the
-    /// observer's state is its owner's to judge).
+    /// What the checkpoint lacks, one sentence each (for the user): a checksum (format versions
+    /// 2 and 3), and of its run record the ledgers (the observer's state is its owner's to
+    /// judge).
     pub fn lacks(&self) -> Vec<String> {
         let mut out = Vec::new();
+        if self.version <= WITHOUT_CHECKSUM {
+            out.push(format!(
+                "a checkpoint of format version {} carries no checksum: a change to it since it \
+                 was written (a flipped bit) cannot be detected",
+                self.version
+            ));
+        }
         if self.record.ledgers.is_none() {
             let why = if self.version <= WITHOUT_RECORD {
                 format!(
@@ -107,7 +126,7 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result
 /// f t of every particle, the contact count and each contact (p, i as u32, its history words,
 /// f, torques, fn); then the run record: a flag (0 or 1) and the ledgers (the flows, a flag and
 /// the reading at the last save: [`put_flows`], [`put_reading`]), a flag and the observer's
-/// state (its length and bytes).
+/// state (its length and bytes); last the SHA-256 digest of all the bytes before it (32 bytes).
 pub fn write_run(
     path: &Path,
     core: &Snapshot,
@@ -169,7 +188,37 @@ pub fn write_run(
         b.extend_from_slice(&(o.len() as u64).to_le_bytes());
         b.extend_from_slice(o);
     }
+    let sum = Sha256::digest(&b);
+    b.extend_from_slice(&sum);
     Ok(crate::io::atomic::write(path, &b)?)
+}
+
+/// The first 8 bytes of `digest` in hex, as messages show a checksum.
+fn short_hex(digest: &[u8]) -> String {
+    digest[..8].iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The bytes of the checkpoint `bytes` of `file` before its checksum, once the checksum is
+/// theirs; else an error naming the file and both digests.
+fn checked_body<'a>(file: &str, bytes: &'a [u8]) -> anyhow::Result<&'a [u8]> {
+    let Some(split) = bytes.len().checked_sub(CHECKSUM_LEN) else {
+        bail!(
+            "{file}: checkpoint truncated: {} bytes, too few for its checksum",
+            bytes.len()
+        );
+    };
+    let (body, stored) = bytes.split_at(split);
+    let found = Sha256::digest(body);
+    if found.as_slice() != stored {
+        bail!(
+            "{file}: refused, a corrupted checkpoint (changed or truncated since it was \
+             written): its checksum says SHA-256 {}…, its {} bytes before it have {}…",
+            short_hex(stored),
+            body.len(),
+            short_hex(&found)
+        );
+    }
+    Ok(body)
 }
 
 /// Appends `flows`: the walls' and gravity's work, the three dissipations, the impulses of the
@@ -383,34 +432,43 @@ pub fn restore(
 }
 
 /// Restores the checkpoint `bytes` of `file` into `engine`, and the ledgers' flows when it
-/// holds them; returns its step and run record. A checkpoint of another format version than 2
-/// or 3, another case (the fields of its tag), another particle count, time step or number of
-/// history words is refused, naming every field that differs; so are a truncated file, trailing
-/// bytes, a number that is not finite, a contact whose particles are not the case's, and
-/// ledgers of another time step, of a law that splits its dissipation otherwise, or read after
-/// the checkpoint's step.
+/// holds them; returns its step and run record. A checkpoint whose checksum is not the SHA-256
+/// of its bytes is refused before anything else is read from it, naming both digests. A
+/// checkpoint of another format version than 2, 3 or 4 (2 and 3 carry no checksum:
+/// [`Resumed::lacks`]), another case (the fields of its tag), another particle count, time step
+/// or number of history words is refused, naming every field that differs; so are a truncated
+/// file, trailing bytes, a count that the rest of the file cannot hold, a number that is not
+/// finite, a contact whose particles are not the case's, and ledgers of another time step, of a
+/// law that splits its dissipation otherwise, or read after the checkpoint's step.
 pub fn restore_run(
     file: &str,
     bytes: &[u8],
     engine: &mut dyn Engine,
     tag: &str,
 ) -> anyhow::Result<Resumed> {
-    let mut r = Reader::new(file, bytes, 0, "checkpoint");
+    let reads = format!(
+        "this verdem reads versions {WITHOUT_RECORD} to {FORMAT_VERSION}: resume with the verdem \
+         that wrote it, or rerun"
+    );
     // A file too short for the magic is not a checkpoint either.
-    match r.take(MAGIC.len()).ok() {
-        Some(m) if m == MAGIC => {}
-        Some(m) if m == MAGIC_V1 => bail!(
-            "{file}: checkpoint format version 1 (an earlier verdem), this verdem reads version \
-             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
-        ),
+    let body = match bytes.get(..MAGIC.len()) {
+        Some(m) if m == MAGIC => checked_body(file, bytes)?,
+        Some(m) if m == MAGIC_UNSUMMED => bytes,
+        Some(m) if m == MAGIC_V1 => {
+            bail!("{file}: checkpoint format version 1 (an earlier verdem), {reads}")
+        }
         _ => bail!("{file}: not a verdem checkpoint"),
-    }
+    };
+    let mut r = Reader::new(file, body, 0, "checkpoint");
+    let unsummed = r.take(MAGIC.len())? == MAGIC_UNSUMMED;
     let version = r.u64()?;
-    if version != FORMAT_VERSION && version != WITHOUT_RECORD {
-        bail!(
-            "{file}: checkpoint format version {version}, this verdem reads version \
-             {WITHOUT_RECORD} or {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun"
-        );
+    let known = if unsummed {
+        (WITHOUT_RECORD..=WITHOUT_CHECKSUM).contains(&version)
+    } else {
+        version == FORMAT_VERSION
+    };
+    if !known {
+        bail!("{file}: checkpoint format version {version}, {reads}");
     }
     let tag_len = r.u64()?;
     let file_tag = String::from_utf8_lossy(r.take(usize::try_from(tag_len).unwrap_or(usize::MAX))?)
@@ -447,12 +505,22 @@ pub fn restore_run(
         p.f[a] = r.vec(&|| format!("particle {id}: force"))?;
         p.t[a] = r.vec(&|| format!("particle {id}: torque"))?;
     }
+    let contacts_at = r.at();
     let contacts = r.u64()?;
     let case_words = engine.history_words();
     if contacts > 0 && words != case_words as u64 {
         bail!(
             "{file}: refused, a checkpoint of another run: {words} history words per contact, the case's \
              law {case_words} (another contact law)"
+        );
+    }
+    // p and i, the history words, f, the two torques and fn (bytes)
+    let contact_len = 8 + 8 * case_words + 8 * 10;
+    let room = (r.b.len() - r.at) / contact_len;
+    if contacts > room as u64 {
+        bail!(
+            "{file}: byte {contacts_at}: the contact count is {contacts}, more than the {room} \
+             the rest of the checkpoint can hold"
         );
     }
     snap.contacts.clear();
@@ -487,7 +555,7 @@ pub fn restore_run(
         });
     }
     let mut record = RunRecord::default();
-    let mut observer_at = bytes.len();
+    let mut observer_at = body.len();
     if version > WITHOUT_RECORD {
         if r.flag(&|| "the ledgers' flag".into())? {
             let flows = r.flows()?;
@@ -515,7 +583,7 @@ pub fn restore_run(
             }
         }
         if r.flag(&|| "the observer's flag".into())? {
-            let len = r.count(bytes.len(), &|| "the observer's state length".into())?;
+            let len = r.count(body.len(), &|| "the observer's state length".into())?;
             observer_at = r.at();
             record.observer = Some(r.take(len)?.to_vec());
         }

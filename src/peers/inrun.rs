@@ -89,13 +89,18 @@ pub fn read_wall_means(path: &Path, every: u64) -> Result<Vec<WallMean>, FormatE
             ));
         }
         let step = step as u64;
-        let expected = out.last().map(|m| m.step + every);
-        if expected.is_some_and(|e| e != step) || !step.is_multiple_of(every.max(1)) {
+        // after the last step number that can be followed, none is expected (`Some(None)`)
+        let expected = out.last().map(|m| m.step.checked_add(every));
+        if expected.is_some_and(|e| e != Some(step)) || !step.is_multiple_of(every.max(1)) {
             return Err(err(
                 line,
                 format!(
                     "column 1 (step): step {step}, expected {} (a mean every {every} steps)",
-                    expected.map_or(format!("a multiple of {every}"), |e| e.to_string())
+                    match expected {
+                        None => format!("a multiple of {every}"),
+                        Some(Some(e)) => e.to_string(),
+                        Some(None) => "none: the step numbers end".into(),
+                    }
                 ),
             ));
         }
