@@ -348,3 +348,204 @@ fn golden_profiles_tables_round_trip_byte_for_byte() {
         assert!(table.csv() == text, "{}", path.display());
     }
 }
+
+/// Runs `verdem cg` on the series `dir/s` as the conservation case sees its saves (no wall
+/// spheres, density 1), 10 slices, 2 blocks, every save, with `more` arguments; fails the test
+/// when it has not finished within a minute (it used to spin forever on a non-finite range).
+fn cg_command(dir: &Path, more: &[&str]) -> std::process::Output {
+    let case = common::root().join("cases/verify/conservation.toml");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .arg("cg")
+        .arg(dir.join("s"))
+        .arg("--case")
+        .arg(case)
+        .args(["--slices", "10", "--blocks", "2", "--from", "0"])
+        .args(more)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("verdem cg did not finish within a minute");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// 40 spheres in two layers at rest but for a drift vx = 0.3, as `(x, v)`.
+fn lattice() -> Vec<([f64; 3], [f64; 3])> {
+    (0..40)
+        .map(|a| {
+            (
+                [
+                    (a % 4) as f64 + 0.5,
+                    (a / 4 % 5) as f64 + 0.5,
+                    1.0 + (a / 20) as f64 * 5.0,
+                ],
+                [0.3, 0.0, 0.0],
+            )
+        })
+        .collect()
+}
+
+/// Every file `verdem cg` writes beside the series, that exists, holds no NaN or infinity.
+fn assert_nothing_non_finite_written(dir: &Path) {
+    for ext in ["profiles.csv", "checks.txt"] {
+        if let Ok(text) = std::fs::read_to_string(dir.join(format!("s.{ext}"))) {
+            let lower = text.to_lowercase();
+            assert!(
+                !lower.contains("nan") && !lower.contains("inf"),
+                "{ext}: {text}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_velocity_too_large_to_square_is_refused_naming_the_file_line_and_value() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        let mut parts = lattice();
+        if k == 2 {
+            parts[7].1[0] = 1e200;
+        }
+        save(dir.path(), k, &parts, &[]);
+    }
+    let out = cg_command(dir.path(), &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    // particle 7 is on line 9 of its save, vx its fourth column
+    assert!(
+        err.contains("s.data.0002:9: particle 7: column 4 (vx): 1e200 is too large"),
+        "{err}"
+    );
+    assert!(!dir.path().join("s.profiles.csv").exists(), "{err}");
+    assert!(!dir.path().join("s.profiles.png").exists(), "{err}");
+    assert_nothing_non_finite_written(dir.path());
+}
+
+#[test]
+fn a_nan_in_a_save_is_refused_naming_the_file_line_and_value() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        save(dir.path(), k, &lattice(), &[]);
+    }
+    let path = dir.path().join("s.data.0001");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[5] = lines[5].replacen(" 0.3 ", " NaN ", 1);
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    let out = cg_command(dir.path(), &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("s.data.0001:6: column 4 (vx): not finite: \"NaN\""),
+        "{err}"
+    );
+    assert!(!dir.path().join("s.profiles.csv").exists(), "{err}");
+    assert_nothing_non_finite_written(dir.path());
+}
+
+/// Velocities whose squares are finite but whose spread over the blocks is not: the profiles'
+/// standard errors would be infinite, and the coarse-graining says so instead.
+#[test]
+fn profiles_whose_errors_overflow_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        let mut parts = lattice();
+        for p in &mut parts {
+            p.1[0] = 1e150 * (k + 1) as f64;
+        }
+        save(dir.path(), k, &parts, &[]);
+    }
+    let series = cg::Series::find(&dir.path().join("s")).unwrap();
+    let e = cg::coarse_grain(&series, &options(0, KernelChoice::Heaviside))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the profiles of saves 0 to 3") && e.contains("not a finite number"),
+        "{e}"
+    );
+    let out = cg_command(dir.path(), &[]);
+    assert!(!out.status.success());
+    assert!(!dir.path().join("s.profiles.csv").exists());
+    assert_nothing_non_finite_written(dir.path());
+}
+
+/// The axis of a plot is total: NaN, infinities and widths beyond the largest number are
+/// refused, zero and huge widths give a usable range, drawing such profiles finishes, and the
+/// benchmark plot's log axes refuse ends they cannot draw.
+#[test]
+fn plot_axes_are_total_and_prompt() {
+    use verdem::analysis::cg::plot::{axis_range, panels_png, Curve};
+    let (tx, rx) = std::sync::mpsc::channel();
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let png_in_thread = png.clone();
+    std::thread::spawn(move || {
+        let mut refused = Vec::new();
+        for (lo, hi) in [
+            (f64::NAN, 1.0),
+            (0.0, f64::INFINITY),
+            (f64::NEG_INFINITY, f64::INFINITY),
+            (-1e308, 1e308),
+            (-f64::MAX, f64::MAX),
+        ] {
+            refused.push(axis_range(lo, hi).is_err());
+        }
+        let mut ranges = Vec::new();
+        for (lo, hi) in [
+            (0.0, 0.0),
+            (5.0, 5.0),
+            (1e308, 1e308),
+            (f64::MAX, f64::MAX),
+            (0.0, 1e308),
+            (1e20, 1e20 + 1e5),
+            (1.0, 1.0 + f64::EPSILON),
+            (-3.0, 2.0),
+        ] {
+            ranges.push(((lo, hi), axis_range(lo, hi).ok()));
+        }
+        let draw = |value: f64| {
+            let curve = Curve {
+                label: "",
+                z: vec![1.0, 2.0, 3.0],
+                value: vec![value; 3],
+                se: vec![0.0; 3],
+            };
+            panels_png(&[("flat".to_string(), vec![curve])], &png_in_thread)
+        };
+        let drawn = [draw(1e308).is_ok(), draw(0.0).is_ok()];
+        let inf = draw(f64::INFINITY).map_err(|e| format!("{e:#}"));
+        // the benchmark's log axes: an end beyond the largest number or below the smallest
+        // normal one is refused
+        let cost = |points: Vec<(f64, f64)>| {
+            verdem::bench::draw_cost(&[("code".to_string(), points)], &png_in_thread).is_err()
+        };
+        refused.push(cost(vec![(1.0, 1.5e308), (2.0, 1.0)]));
+        refused.push(cost(vec![(1.0, 5e-324), (2.0, 1.0)]));
+        tx.send((refused, ranges, drawn, inf)).unwrap();
+    });
+    let (refused, ranges, drawn, inf) = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the axes and plots finish within a minute");
+    assert_eq!(refused, vec![true; 7]);
+    for ((lo, hi), r) in ranges {
+        let r = r.unwrap_or_else(|| panic!("{lo}..{hi} refused"));
+        assert!(
+            r.start.is_finite() && r.end.is_finite() && (r.end - r.start).is_finite(),
+            "{lo}..{hi}: {r:?}"
+        );
+        assert!(
+            r.start <= lo && r.end >= hi && r.start < r.end,
+            "{lo}..{hi}: {r:?}"
+        );
+    }
+    assert_eq!(drawn, [true, true]);
+    let e = inf.unwrap_err();
+    assert!(e.contains("p.png: cannot draw") && e.contains("inf"), "{e}");
+}

@@ -335,8 +335,35 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
                     head.rows.len()
                 );
             }
+            let (data_path, fstat_path) = (series.path("data", k), series.path("fstat", k));
+            usable(
+                &data,
+                &fstat,
+                &is_wall,
+                &domain,
+                o.density,
+                &data_path,
+                &fstat_path,
+            )?;
             let raw = raw_fields(&data, &fstat, &is_wall, &domain, &grid, kernel, o.density);
-            Ok((raw, wall_forces(&fstat, &is_wall, &data)))
+            if let Some((field, at, v)) = first_non_finite(&raw) {
+                bail!(
+                    "{}: the coarse-grained {field} at z = {} is {v}: the save's numbers add up \
+                     beyond the largest number{}",
+                    data_path.display(),
+                    grid.z(at),
+                    fastest(&data, &is_wall)
+                );
+            }
+            let forces = wall_forces(&fstat, &is_wall, &data);
+            if forces.iter().any(|f| !f.iter().all(|c| c.is_finite())) {
+                bail!(
+                    "{}: the force on a wall is not a finite number: its contacts' forces add up \
+                     beyond the largest number",
+                    fstat_path.display()
+                );
+            }
+            Ok((raw, forces))
         })
         .collect();
     let mut per_save = Vec::with_capacity(saves.len());
@@ -385,7 +412,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     };
     let tau_shear = integrated_autocorrelation(&series_of(&|d| d.shear));
     let tau_energy = integrated_autocorrelation(&series_of(&|d| d.kinetic.trace()));
-    Ok(Profiles {
+    let profiles = Profiles {
         grid,
         kernel,
         saves,
@@ -402,7 +429,114 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         tau_shear,
         tau_energy,
         trusted: vec![true; COLUMNS.len()],
+    };
+    Table::of(&profiles).ensure_finite(
+        &format!(
+            "{}: the profiles of saves {first} to {last}",
+            series.dir.join(&series.name).display()
+        ),
+        "the saves' numbers are too large for the averages and their spread",
+    )?;
+    Ok(profiles)
+}
+
+/// Refuses a save whose numbers the coarse-graining cannot carry, naming the file, the line or
+/// contact, the column and the value: a free particle whose mass (from its radius and
+/// `density`, mass/length³) or whose mass times the square of a velocity component (the
+/// momentum flux it adds, mass·length²/time²) is not a finite number, and a contact whose
+/// force or whose force times its branch (f⊗l, force·length) is not.
+fn usable(
+    data: &mercury::DataFile,
+    fstat: &mercury::FstatFile,
+    is_wall: &dyn Fn(usize) -> bool,
+    domain: &Domain,
+    density: f64,
+    data_path: &Path,
+    fstat_path: &Path,
+) -> anyhow::Result<()> {
+    for (i, p) in data.rows.iter().enumerate() {
+        if is_wall(i) {
+            continue;
+        }
+        let m = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3) * density;
+        if !m.is_finite() {
+            bail!(
+                "{}:{}: particle {i}: column 7 (radius): {:e} is too large to coarse-grain: its \
+                 mass is not a finite number",
+                data_path.display(),
+                p.line,
+                p.radius
+            );
+        }
+        for (c, name) in ["vx", "vy", "vz"].iter().enumerate() {
+            let v = p.v[c];
+            if !(m * v * v).is_finite() {
+                bail!(
+                    "{}:{}: particle {i}: column {} ({name}): {v:e} is too large to coarse-grain: \
+                     its momentum flux m·{name}² is not a finite number",
+                    data_path.display(),
+                    p.line,
+                    4 + c
+                );
+            }
+        }
+    }
+    for (k, r) in fstat.rows.iter().enumerate() {
+        let f = r.fn_signed * r.n + r.ft * r.t;
+        let start = if is_wall(r.j) { r.c } else { data.rows[r.j].x };
+        let branch = domain.min_image(data.rows[r.i].x - start);
+        let tensor = f * branch.transpose();
+        if !(f.iter().chain(tensor.iter()).all(|x| x.is_finite())) {
+            bail!(
+                "{}: contact {} (particles {} and {}): fn = {:e}, ft = {:e}, branch length {:e}: \
+                 too large to coarse-grain: its force or its f⊗l is not a finite number",
+                fstat_path.display(),
+                k + 1,
+                r.i,
+                r.j,
+                r.fn_signed,
+                r.ft,
+                branch.norm()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The first raw field of `raw` that is NaN or infinite: (its name, its grid point, the value).
+fn first_non_finite(raw: &Raw) -> Option<(&'static str, usize, f64)> {
+    (0..raw.nu.len()).find_map(|k| {
+        let fields: [(&'static str, Vec<f64>); 5] = [
+            ("volume fraction", vec![raw.nu[k]]),
+            ("density", vec![raw.rho[k]]),
+            ("momentum", raw.momentum[k].iter().copied().collect()),
+            ("momentum flux", raw.flux[k].iter().copied().collect()),
+            ("contact stress", raw.contact[k].iter().copied().collect()),
+        ];
+        fields.into_iter().find_map(|(name, values)| {
+            values
+                .into_iter()
+                .find(|v| !v.is_finite())
+                .map(|v| (name, k, v))
+        })
     })
+}
+
+/// The fastest free particle of a save in words, for messages: "; the fastest: particle I
+/// (line L), speed S" (empty without free particles).
+fn fastest(data: &mercury::DataFile, is_wall: &dyn Fn(usize) -> bool) -> String {
+    data.rows
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !is_wall(*i))
+        .max_by(|a, b| a.1.v.amax().total_cmp(&b.1.v.amax()))
+        .map_or(String::new(), |(i, p)| {
+            format!(
+                "; the fastest: particle {i} (line {}), largest velocity component {:e}",
+                p.line,
+                p.v.amax()
+            )
+        })
 }
 
 /// Grid points of the core (see [`core_window`]).
