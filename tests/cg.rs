@@ -549,3 +549,43 @@ fn plot_axes_are_total_and_prompt() {
     let e = inf.unwrap_err();
     assert!(e.contains("p.png: cannot draw") && e.contains("inf"), "{e}");
 }
+
+/// Two tables without error bars whose means differ by 155 %: `verdem compare` says the χ² is
+/// undefined and gives the difference, never a χ² of 0 that reads as agreement.
+#[test]
+fn compare_without_error_bars_says_chi2_is_undefined() {
+    use verdem::analysis::cg::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let flat = |value: f64| {
+        let z: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 0.22).collect();
+        Table {
+            mean: z.iter().map(|_| vec![value; COLUMNS.len()]).collect(),
+            se: z.iter().map(|_| vec![0.0; COLUMNS.len()]).collect(),
+            z,
+        }
+    };
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    std::fs::write(&a, flat(1.0).csv()).unwrap();
+    std::fs::write(&b, flat(2.55).csv()).unwrap();
+    let out = common::verdem_ok([
+        "compare".as_ref(),
+        a.as_os_str(),
+        b.as_os_str(),
+        "--labels".as_ref(),
+        "ref,other".as_ref(),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("`other`: χ² undefined: no error bars in either table."),
+        "{text}"
+    );
+    assert!(text.contains("+155.00 %"), "{text}");
+    assert!(
+        text.contains("| other | undefined | undefined | undefined |"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("| 0.00 |") && !text.contains("NaN"),
+        "{text}"
+    );
+}
