@@ -589,3 +589,37 @@ fn compare_without_error_bars_says_chi2_is_undefined() {
         "{text}"
     );
 }
+
+/// A series with one `.fstat` or one `.data` missing: `verdem cg` names the missing file and
+/// writes nothing; with `--skip-incomplete` it warns, naming it, and coarse-grains the others.
+#[test]
+fn an_incomplete_save_is_said_or_skipped_with_a_warning() {
+    for missing in ["fstat", "data"] {
+        let dir = tempfile::tempdir().unwrap();
+        for k in 0..4 {
+            save(dir.path(), k, &lattice(), &[]);
+        }
+        std::fs::remove_file(dir.path().join(format!("s.{missing}.0002"))).unwrap();
+        let out = cg_command(dir.path(), &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{err}");
+        assert!(
+            err.contains(&format!("s.{missing}.0002: missing (save 2 has "))
+                && err.contains("--skip-incomplete"),
+            "{err}"
+        );
+        assert!(!dir.path().join("s.profiles.csv").exists());
+        let out = cg_command(dir.path(), &["--skip-incomplete"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(
+            err.contains("warning: save 2 skipped: ")
+                && err.contains(&format!("s.{missing}.0002: missing")),
+            "{err}"
+        );
+        assert!(dir.path().join("s.profiles.csv").exists());
+        let (series, incomplete) = cg::Series::scan(&dir.path().join("s")).unwrap();
+        assert_eq!(series.saves, [0, 1, 3]);
+        assert_eq!(incomplete.len(), 1);
+    }
+}

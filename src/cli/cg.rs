@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
 
-use super::args::{count, named, positive};
+use super::args::{complete_series, count, named, positive};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -37,6 +37,10 @@ pub struct Args {
     /// Blocks of saves for the standard errors.
     #[arg(long, default_value_t = CgOptions::default().blocks, value_parser = count::<usize>)]
     blocks: usize,
+    /// Skip, with a warning naming each, the saves that have a `.data` or a `.fstat` file only
+    /// (without it such a save is an error).
+    #[arg(long)]
+    skip_incomplete: bool,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -53,7 +57,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         blocks: a.blocks,
         ..saves
     };
-    let (_, report) = cg::write_all(&a.base, &o)?;
+    let series = complete_series(&a.base, a.skip_incomplete)?;
+    let (_, report) = cg::write_series(&series, &o)?;
     print!("{report}");
     Ok(Finished::Done)
 }

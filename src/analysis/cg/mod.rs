@@ -11,6 +11,7 @@ pub mod kernel;
 pub mod plot;
 pub mod table;
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
@@ -147,9 +148,41 @@ pub struct Series {
     pub saves: Vec<u64>,
 }
 
+/// A save of a series with one of its two files only.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Incomplete {
+    pub save: u64,
+    /// The file that is there and the one that is not.
+    pub present: PathBuf,
+    pub missing: PathBuf,
+}
+
+impl std::fmt::Display for Incomplete {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: missing (save {} has {} only)",
+            self.missing.display(),
+            self.save,
+            self.present.display()
+        )
+    }
+}
+
 impl Series {
-    /// Finds the saves of `base` = `DIR/NAME`.
+    /// Finds the saves of `base` = `DIR/NAME`; a save with one of its two files only is an
+    /// error naming the missing file ([`Series::scan`] lists them instead).
     pub fn find(base: &Path) -> anyhow::Result<Series> {
+        let (series, incomplete) = Series::scan(base)?;
+        if !incomplete.is_empty() {
+            bail!("{}", incomplete_saves(&incomplete));
+        }
+        Ok(series)
+    }
+
+    /// Finds the saves of `base` = `DIR/NAME` that have both files, and the saves that have
+    /// one of them only (by save number); an error when no save has both.
+    pub fn scan(base: &Path) -> anyhow::Result<(Series, Vec<Incomplete>)> {
         let dir = base
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
@@ -160,34 +193,69 @@ impl Series {
             .and_then(|n| n.to_str())
             .with_context(|| format!("{}: not a series base name", base.display()))?
             .to_string();
-        let prefix = format!("{name}.data.");
-        let mut saves = Vec::new();
+        let (mut data, mut fstat) = (BTreeSet::new(), BTreeSet::new());
         for entry in
             std::fs::read_dir(&dir).with_context(|| format!("{}: cannot list", dir.display()))?
         {
             let file = entry?.file_name();
-            let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            let Some(file) = file.to_str() else {
                 continue;
             };
-            if let Ok(k) = rest.parse::<u64>() {
-                if dir.join(format!("{name}.fstat.{rest}")).exists() {
-                    saves.push(k);
-                }
+            let number = |ext: &str| {
+                file.strip_prefix(&format!("{name}.{ext}."))?
+                    .parse::<u64>()
+                    .ok()
+            };
+            if let Some(k) = number("data") {
+                data.insert(k);
+            } else if let Some(k) = number("fstat") {
+                fstat.insert(k);
             }
         }
-        saves.sort_unstable();
+        let path = |ext: &str, k: u64| mercury::save_path(&dir, &name, ext, k);
+        let incomplete: Vec<Incomplete> = data
+            .symmetric_difference(&fstat)
+            .map(|&k| {
+                let (present, missing) = if data.contains(&k) {
+                    ("data", "fstat")
+                } else {
+                    ("fstat", "data")
+                };
+                Incomplete {
+                    save: k,
+                    present: path(present, k),
+                    missing: path(missing, k),
+                }
+            })
+            .collect();
+        let saves: Vec<u64> = data.intersection(&fstat).copied().collect();
         if saves.is_empty() {
             bail!(
                 "{}: no {name}.data.NNNN with a matching .fstat.NNNN",
                 dir.display()
             );
         }
-        Ok(Series { dir, name, saves })
+        Ok((Series { dir, name, saves }, incomplete))
     }
 
     fn path(&self, ext: &str, k: u64) -> PathBuf {
         mercury::save_path(&self.dir, &self.name, ext, k)
     }
+}
+
+/// The incomplete saves `list` in words, for an error or a warning: the first three (the
+/// missing file of each), and how many more there are.
+pub fn incomplete_saves(list: &[Incomplete]) -> String {
+    let mut s = list
+        .iter()
+        .take(3)
+        .map(Incomplete::to_string)
+        .collect::<Vec<_>>()
+        .join("; ");
+    if list.len() > 3 {
+        s.push_str(&format!("; and {} more incomplete saves", list.len() - 3));
+    }
+    s
 }
 
 /// Profiles with standard errors.
@@ -585,8 +653,12 @@ pub fn csv(p: &Profiles) -> String {
 /// Coarse-grains `base` and writes `NAME.profiles.csv`, `NAME.profiles.png` and
 /// `NAME.checks.txt` beside it; returns the profiles and the checks' report.
 pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
-    let series = Series::find(base)?;
-    let p = coarse_grain(&series, o)?;
+    write_series(&Series::find(base)?, o)
+}
+
+/// As [`write_all`], for the saves of `series`.
+pub fn write_series(series: &Series, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
+    let p = coarse_grain(series, o)?;
     let out = |ext: &str| series.dir.join(format!("{}.{ext}", series.name));
     crate::io::atomic::write(&out("profiles.csv"), csv(&p).as_bytes())?;
     let mut report = checks::report(&p, &checks::run(&p, o.density));
