@@ -392,17 +392,54 @@ fn lattice() -> Vec<([f64; 3], [f64; 3])> {
         .collect()
 }
 
-/// Every file `verdem cg` writes beside the series, that exists, holds no NaN or infinity.
+/// Every file `verdem cg` writes beside the series, that exists, holds no NaN or infinity
+/// (no word that reads as one as a number).
 fn assert_nothing_non_finite_written(dir: &Path) {
     for ext in ["profiles.csv", "checks.txt"] {
         if let Ok(text) = std::fs::read_to_string(dir.join(format!("s.{ext}"))) {
-            let lower = text.to_lowercase();
-            assert!(
-                !lower.contains("nan") && !lower.contains("inf"),
-                "{ext}: {text}"
-            );
+            let bad = text
+                .split(|c: char| c.is_whitespace() || ",()[]:;=".contains(c))
+                .find(|w| w.parse::<f64>().is_ok_and(|v| !v.is_finite()));
+            assert_eq!(bad, None, "{ext}: {text}");
         }
     }
+}
+
+/// The check itself: it sees a NaN and an infinity, and not the word "info".
+#[test]
+fn the_check_for_non_finite_numbers_sees_them() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.checks.txt"),
+        "info  x: 1.5 (expected 0)\n",
+    )
+    .unwrap();
+    assert_nothing_non_finite_written(dir.path());
+    for bad in ["1,NaN,2\n", "chi2/dof = inf\n"] {
+        std::fs::write(dir.path().join("s.profiles.csv"), bad).unwrap();
+        let caught = std::panic::catch_unwind(|| assert_nothing_non_finite_written(dir.path()));
+        assert!(caught.is_err(), "{bad}");
+    }
+}
+
+/// A series whose profiles are exact (a uniform drift, no contacts, no spread over the saves):
+/// `verdem cg` writes its files, and none holds a NaN or an infinity (an exact trend's
+/// infinitely many standard errors read "undefined").
+#[test]
+fn an_exact_series_is_written_without_a_non_finite_number() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..8 {
+        save(dir.path(), k, &lattice(), &[]);
+    }
+    let out = cg_command(dir.path(), &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("s.profiles.csv").exists());
+    assert!(dir.path().join("s.profiles.png").exists());
+    assert_nothing_non_finite_written(dir.path());
 }
 
 #[test]
