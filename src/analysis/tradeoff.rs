@@ -176,6 +176,41 @@ impl Outcome {
     pub fn wall_per_time(&self) -> f64 {
         self.wall_seconds / self.simulated()
     }
+
+    /// The first of its numbers (what [`csv`] and [`replicas_csv`] write) that is NaN or
+    /// infinite, named; `None` when all are finite.
+    pub fn first_non_finite(&self) -> Option<(String, f64)> {
+        let times = [
+            ("dt", self.dt),
+            ("CPU time", self.cpu_seconds),
+            ("wall time", self.wall_seconds),
+            ("restitution error", self.restitution_error),
+        ];
+        let core = |c: &[CoreMean], of: &str| {
+            c.iter()
+                .zip(FIELDS)
+                .flat_map(|(m, (field, _))| {
+                    [
+                        ("core mean", m.mean),
+                        ("standard error", m.se),
+                        ("dof", m.dof),
+                    ]
+                    .map(|(what, x)| (format!("{what} of {field}{of}"), x))
+                })
+                .collect::<Vec<_>>()
+        };
+        times
+            .into_iter()
+            .map(|(what, x)| (what.to_string(), x))
+            .chain(core(&self.core, ""))
+            .chain(
+                self.replica_core
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(k, c)| core(c, &format!(" in replica {k}"))),
+            )
+            .find(|(_, x)| !x.is_finite())
+    }
 }
 
 /// The core means of independent replicas merged. One replica: its own. R ≥ 2: their mean,
@@ -346,6 +381,12 @@ pub fn run(
             core,
             replica_core: parts,
         };
+        if let Some((what, x)) = o.first_non_finite() {
+            bail!(
+                "{}: the {what} is {x}, not a finite number; nothing written",
+                o.name
+            );
+        }
         done(&o);
         outcomes.push(o);
     }
@@ -834,6 +875,28 @@ mod tests {
             core: Vec::new(),
             replica_core: Vec::new(),
         }
+    }
+
+    #[test]
+    fn a_number_that_is_not_finite_is_named() {
+        let finite = CoreMean {
+            mean: 1.0,
+            se: 0.1,
+            dof: 4.0,
+            long_enough: true,
+        };
+        let mut o = outcome(REFERENCE, "abc");
+        o.core = vec![finite; FIELDS.len()];
+        o.replica_core = vec![vec![finite; FIELDS.len()]; 2];
+        assert_eq!(o.first_non_finite(), None);
+        o.replica_core[1][2].se = f64::INFINITY;
+        let (what, x) = o.first_non_finite().unwrap();
+        assert_eq!(
+            (what.as_str(), x),
+            ("standard error of T in replica 1", f64::INFINITY)
+        );
+        o.core[0].mean = f64::NAN;
+        assert_eq!(o.first_non_finite().unwrap().0, "core mean of vx");
     }
 
     #[test]
