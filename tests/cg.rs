@@ -515,7 +515,7 @@ fn profiles_whose_errors_overflow_are_refused() {
 
 /// The axis of a plot is total: NaN, infinities and widths beyond the largest number are
 /// refused, zero and huge widths give a usable range, drawing such profiles finishes, and the
-/// benchmark plot's log axes refuse ends they cannot draw.
+/// benchmark plot's log axes and the particles' picture refuse ranges they cannot draw.
 #[test]
 fn plot_axes_are_total_and_prompt() {
     use verdem::analysis::cg::plot::{axis_range, panels_png, Curve};
@@ -556,7 +556,7 @@ fn plot_axes_are_total_and_prompt() {
             };
             panels_png(&[("flat".to_string(), vec![curve])], &png_in_thread)
         };
-        let drawn = [draw(1e308).is_ok(), draw(0.0).is_ok()];
+        let mut drawn = vec![draw(1e308).is_ok(), draw(0.0).is_ok()];
         let inf = draw(f64::INFINITY).map_err(|e| format!("{e:#}"));
         // the benchmark's log axes: an end beyond the largest number or below the smallest
         // normal one is refused
@@ -565,12 +565,31 @@ fn plot_axes_are_total_and_prompt() {
         };
         refused.push(cost(vec![(1.0, 1.5e308), (2.0, 1.0)]));
         refused.push(cost(vec![(1.0, 5e-324), (2.0, 1.0)]));
+        // the particles' picture: a box too wide for its axes is refused
+        let sphere = verdem::io::vtk::Particle {
+            x: verdem::Vec3::zeros(),
+            v: verdem::Vec3::new(1e308, 0.0, 0.0),
+            w: verdem::Vec3::zeros(),
+            radius: 0.5,
+            wall: false,
+        };
+        let picture = |lo: f64, hi: f64| {
+            verdem::analysis::particles::particles_png(
+                std::slice::from_ref(&sphere),
+                &verdem::Vec3::from_element(lo),
+                &verdem::Vec3::from_element(hi),
+                "t",
+                &png_in_thread,
+            )
+        };
+        refused.push(picture(-1e308, 1e308).is_err());
+        drawn.push(picture(-1.0, 1.0).is_ok());
         tx.send((refused, ranges, drawn, inf)).unwrap();
     });
     let (refused, ranges, drawn, inf) = rx
         .recv_timeout(std::time::Duration::from_secs(60))
         .expect("the axes and plots finish within a minute");
-    assert_eq!(refused, vec![true; 7]);
+    assert_eq!(refused, vec![true; 8]);
     for ((lo, hi), r) in ranges {
         let r = r.unwrap_or_else(|| panic!("{lo}..{hi} refused"));
         assert!(
@@ -582,7 +601,7 @@ fn plot_axes_are_total_and_prompt() {
             "{lo}..{hi}: {r:?}"
         );
     }
-    assert_eq!(drawn, [true, true]);
+    assert_eq!(drawn, [true; 3]);
     let e = inf.unwrap_err();
     assert!(e.contains("p.png: cannot draw") && e.contains("inf"), "{e}");
 }
