@@ -590,8 +590,9 @@ fn first_non_finite(raw: &Raw) -> Option<(&'static str, usize, f64)> {
     })
 }
 
-/// The fastest free particle of a save in words, for messages: "; the fastest: particle I
-/// (line L), speed S" (empty without free particles).
+/// The fastest free particle of a save (by its largest velocity component in magnitude) in
+/// words, for messages: "; the fastest: particle I (line L), largest velocity component V"
+/// (empty without free particles).
 fn fastest(data: &mercury::DataFile, is_wall: &dyn Fn(usize) -> bool) -> String {
     data.rows
         .iter()
