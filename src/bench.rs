@@ -1088,6 +1088,14 @@ pub fn draw_cost(lines: &[CostLine], path: &Path) -> anyhow::Result<()> {
     if !(nlo.is_finite() && clo.is_finite()) {
         anyhow::bail!("{}: no measured rate to plot", path.display());
     }
+    // the log axes span a factor 1.5 beyond the points: both ends normal positive numbers
+    for (what, lo, hi) in [("particles", nlo, nhi), ("ns per particle-step", clo, chi)] {
+        anyhow::ensure!(
+            lo / 1.5 >= f64::MIN_POSITIVE && (hi * 1.5).is_finite(),
+            "{}: cannot draw {what} from {lo:e} to {hi:e} on a log axis",
+            path.display()
+        );
+    }
     let colours = [
         BLUE,
         RED,

@@ -348,3 +348,334 @@ fn golden_profiles_tables_round_trip_byte_for_byte() {
         assert!(table.csv() == text, "{}", path.display());
     }
 }
+
+/// Runs `verdem cg` on the series `dir/s` as the conservation case sees its saves (no wall
+/// spheres, density 1), 10 slices, 2 blocks, every save, with `more` arguments; fails the test
+/// when it has not finished within a minute (it used to spin forever on a non-finite range).
+fn cg_command(dir: &Path, more: &[&str]) -> std::process::Output {
+    let case = common::root().join("cases/verify/conservation.toml");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .arg("cg")
+        .arg(dir.join("s"))
+        .arg("--case")
+        .arg(case)
+        .args(["--slices", "10", "--blocks", "2", "--from", "0"])
+        .args(more)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("verdem cg did not finish within a minute");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// 40 spheres in two layers at rest but for a drift vx = 0.3, as `(x, v)`.
+fn lattice() -> Vec<([f64; 3], [f64; 3])> {
+    (0..40)
+        .map(|a| {
+            (
+                [
+                    (a % 4) as f64 + 0.5,
+                    (a / 4 % 5) as f64 + 0.5,
+                    1.0 + (a / 20) as f64 * 5.0,
+                ],
+                [0.3, 0.0, 0.0],
+            )
+        })
+        .collect()
+}
+
+/// Every file `verdem cg` writes beside the series, that exists, holds no NaN or infinity
+/// (no word that reads as one as a number).
+fn assert_nothing_non_finite_written(dir: &Path) {
+    for ext in ["profiles.csv", "checks.txt"] {
+        if let Ok(text) = std::fs::read_to_string(dir.join(format!("s.{ext}"))) {
+            let bad = text
+                .split(|c: char| c.is_whitespace() || ",()[]:;=".contains(c))
+                .find(|w| w.parse::<f64>().is_ok_and(|v| !v.is_finite()));
+            assert_eq!(bad, None, "{ext}: {text}");
+        }
+    }
+}
+
+/// The check itself: it sees a NaN and an infinity, and not the word "info".
+#[test]
+fn the_check_for_non_finite_numbers_sees_them() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.checks.txt"),
+        "info  x: 1.5 (expected 0)\n",
+    )
+    .unwrap();
+    assert_nothing_non_finite_written(dir.path());
+    for bad in ["1,NaN,2\n", "chi2/dof = inf\n"] {
+        std::fs::write(dir.path().join("s.profiles.csv"), bad).unwrap();
+        let caught = std::panic::catch_unwind(|| assert_nothing_non_finite_written(dir.path()));
+        assert!(caught.is_err(), "{bad}");
+    }
+}
+
+/// A series whose profiles are exact (a uniform drift, no contacts, no spread over the saves):
+/// `verdem cg` writes its files, and none holds a NaN or an infinity (an exact trend's
+/// infinitely many standard errors read "undefined").
+#[test]
+fn an_exact_series_is_written_without_a_non_finite_number() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..8 {
+        save(dir.path(), k, &lattice(), &[]);
+    }
+    let out = cg_command(dir.path(), &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("s.profiles.csv").exists());
+    assert!(dir.path().join("s.profiles.png").exists());
+    assert_nothing_non_finite_written(dir.path());
+}
+
+#[test]
+fn a_velocity_too_large_to_square_is_refused_naming_the_file_line_and_value() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        let mut parts = lattice();
+        if k == 2 {
+            parts[7].1[0] = 1e200;
+        }
+        save(dir.path(), k, &parts, &[]);
+    }
+    let out = cg_command(dir.path(), &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    // particle 7 is on line 9 of its save, vx its fourth column
+    assert!(
+        err.contains("s.data.0002:9: particle 7: column 4 (vx): 1e200 is too large"),
+        "{err}"
+    );
+    assert!(!dir.path().join("s.profiles.csv").exists(), "{err}");
+    assert!(!dir.path().join("s.profiles.png").exists(), "{err}");
+    assert_nothing_non_finite_written(dir.path());
+}
+
+#[test]
+fn a_nan_in_a_save_is_refused_naming_the_file_line_and_value() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        save(dir.path(), k, &lattice(), &[]);
+    }
+    let path = dir.path().join("s.data.0001");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[5] = lines[5].replacen(" 0.3 ", " NaN ", 1);
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    let out = cg_command(dir.path(), &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("s.data.0001:6: column 4 (vx): not finite: \"NaN\""),
+        "{err}"
+    );
+    assert!(!dir.path().join("s.profiles.csv").exists(), "{err}");
+    assert_nothing_non_finite_written(dir.path());
+}
+
+/// Velocities whose squares are finite but whose spread over the blocks is not: the profiles'
+/// standard errors would be infinite, and the coarse-graining says so instead.
+#[test]
+fn profiles_whose_errors_overflow_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for k in 0..4 {
+        let mut parts = lattice();
+        for p in &mut parts {
+            p.1[0] = 1e150 * (k + 1) as f64;
+        }
+        save(dir.path(), k, &parts, &[]);
+    }
+    let series = cg::Series::find(&dir.path().join("s")).unwrap();
+    let e = cg::coarse_grain(&series, &options(0, KernelChoice::Heaviside))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the profiles of saves 0 to 3") && e.contains("not a finite number"),
+        "{e}"
+    );
+    let out = cg_command(dir.path(), &[]);
+    assert!(!out.status.success());
+    assert!(!dir.path().join("s.profiles.csv").exists());
+    assert_nothing_non_finite_written(dir.path());
+}
+
+/// The axis of a plot is total: NaN, infinities and widths beyond the largest number are
+/// refused, zero and huge widths give a usable range, drawing such profiles finishes, and the
+/// benchmark plot's log axes and the particles' picture refuse ranges they cannot draw.
+#[test]
+fn plot_axes_are_total_and_prompt() {
+    use verdem::analysis::cg::plot::{axis_range, panels_png, Curve};
+    let (tx, rx) = std::sync::mpsc::channel();
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let png_in_thread = png.clone();
+    std::thread::spawn(move || {
+        let mut refused = Vec::new();
+        for (lo, hi) in [
+            (f64::NAN, 1.0),
+            (0.0, f64::INFINITY),
+            (f64::NEG_INFINITY, f64::INFINITY),
+            (-1e308, 1e308),
+            (-f64::MAX, f64::MAX),
+        ] {
+            refused.push(axis_range(lo, hi).is_err());
+        }
+        let mut ranges = Vec::new();
+        for (lo, hi) in [
+            (0.0, 0.0),
+            (5.0, 5.0),
+            (1e308, 1e308),
+            (f64::MAX, f64::MAX),
+            (0.0, 1e308),
+            (1e20, 1e20 + 1e5),
+            (1.0, 1.0 + f64::EPSILON),
+            (-3.0, 2.0),
+        ] {
+            ranges.push(((lo, hi), axis_range(lo, hi).ok()));
+        }
+        let draw = |value: f64| {
+            let curve = Curve {
+                label: "",
+                z: vec![1.0, 2.0, 3.0],
+                value: vec![value; 3],
+                se: vec![0.0; 3],
+            };
+            panels_png(&[("flat".to_string(), vec![curve])], &png_in_thread)
+        };
+        let mut drawn = vec![draw(1e308).is_ok(), draw(0.0).is_ok()];
+        let inf = draw(f64::INFINITY).map_err(|e| format!("{e:#}"));
+        // the benchmark's log axes: an end beyond the largest number or below the smallest
+        // normal one is refused
+        let cost = |points: Vec<(f64, f64)>| {
+            verdem::bench::draw_cost(&[("code".to_string(), points)], &png_in_thread).is_err()
+        };
+        refused.push(cost(vec![(1.0, 1.5e308), (2.0, 1.0)]));
+        refused.push(cost(vec![(1.0, 5e-324), (2.0, 1.0)]));
+        // the particles' picture: a box too wide for its axes is refused
+        let sphere = verdem::io::vtk::Particle {
+            x: verdem::Vec3::zeros(),
+            v: verdem::Vec3::new(1e308, 0.0, 0.0),
+            w: verdem::Vec3::zeros(),
+            radius: 0.5,
+            wall: false,
+        };
+        let picture = |lo: f64, hi: f64| {
+            verdem::analysis::particles::particles_png(
+                std::slice::from_ref(&sphere),
+                &verdem::Vec3::from_element(lo),
+                &verdem::Vec3::from_element(hi),
+                "t",
+                &png_in_thread,
+            )
+        };
+        refused.push(picture(-1e308, 1e308).is_err());
+        drawn.push(picture(-1.0, 1.0).is_ok());
+        tx.send((refused, ranges, drawn, inf)).unwrap();
+    });
+    let (refused, ranges, drawn, inf) = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the axes and plots finish within a minute");
+    assert_eq!(refused, vec![true; 8]);
+    for ((lo, hi), r) in ranges {
+        let r = r.unwrap_or_else(|| panic!("{lo}..{hi} refused"));
+        assert!(
+            r.start.is_finite() && r.end.is_finite() && (r.end - r.start).is_finite(),
+            "{lo}..{hi}: {r:?}"
+        );
+        assert!(
+            r.start <= lo && r.end >= hi && r.start < r.end,
+            "{lo}..{hi}: {r:?}"
+        );
+    }
+    assert_eq!(drawn, [true; 3]);
+    let e = inf.unwrap_err();
+    assert!(e.contains("p.png: cannot draw") && e.contains("inf"), "{e}");
+}
+
+/// Two tables without error bars whose means differ by 155 %: `verdem compare` says the χ² is
+/// undefined and gives the difference, never a χ² of 0 that reads as agreement.
+#[test]
+fn compare_without_error_bars_says_chi2_is_undefined() {
+    use verdem::analysis::cg::table::Table;
+    let dir = tempfile::tempdir().unwrap();
+    let flat = |value: f64| {
+        let z: Vec<f64> = (0..100).map(|k| (k as f64 + 0.5) * 0.22).collect();
+        Table {
+            mean: z.iter().map(|_| vec![value; COLUMNS.len()]).collect(),
+            se: z.iter().map(|_| vec![0.0; COLUMNS.len()]).collect(),
+            z,
+        }
+    };
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    std::fs::write(&a, flat(1.0).csv()).unwrap();
+    std::fs::write(&b, flat(2.55).csv()).unwrap();
+    let out = common::verdem_ok([
+        "compare".as_ref(),
+        a.as_os_str(),
+        b.as_os_str(),
+        "--labels".as_ref(),
+        "ref,other".as_ref(),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("`other`: χ² undefined: no error bars in either table."),
+        "{text}"
+    );
+    assert!(text.contains("+155.00 %"), "{text}");
+    assert!(
+        text.contains("| other | undefined | undefined | undefined |"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("| 0.00 |") && !text.contains("NaN"),
+        "{text}"
+    );
+}
+
+/// A series with one `.fstat` or one `.data` missing: `verdem cg` names the missing file and
+/// writes nothing; with `--skip-incomplete` it warns, naming it, and coarse-grains the others.
+#[test]
+fn an_incomplete_save_is_said_or_skipped_with_a_warning() {
+    for missing in ["fstat", "data"] {
+        let dir = tempfile::tempdir().unwrap();
+        for k in 0..4 {
+            save(dir.path(), k, &lattice(), &[]);
+        }
+        std::fs::remove_file(dir.path().join(format!("s.{missing}.0002"))).unwrap();
+        let out = cg_command(dir.path(), &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{err}");
+        assert!(
+            err.contains(&format!("s.{missing}.0002: missing (save 2 has "))
+                && err.contains("--skip-incomplete"),
+            "{err}"
+        );
+        assert!(!dir.path().join("s.profiles.csv").exists());
+        let out = cg_command(dir.path(), &["--skip-incomplete"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(
+            err.contains("warning: save 2 skipped: ")
+                && err.contains(&format!("s.{missing}.0002: missing")),
+            "{err}"
+        );
+        assert!(dir.path().join("s.profiles.csv").exists());
+        let (series, incomplete) = cg::Series::scan(&dir.path().join("s")).unwrap();
+        assert_eq!(series.saves, [0, 1, 3]);
+        assert_eq!(incomplete.len(), 1);
+    }
+}

@@ -445,3 +445,26 @@ fn slurm_failures_are_reported_with_task_log_and_exit_code() {
         failures_are_reported("slurm");
     }
 }
+
+/// Replicas whose values are finite but too large for their mean and spread: the merge is
+/// refused, naming the field and the number, rather than written with infinities.
+#[test]
+fn a_merge_that_overflows_is_refused() {
+    use verdem::analysis::cg::{table::Table, COLUMNS};
+    let flat = |value: f64| {
+        let z: Vec<f64> = (0..10).map(|k| 0.5 + k as f64).collect();
+        Table {
+            mean: z.iter().map(|_| vec![value; COLUMNS.len()]).collect(),
+            se: z.iter().map(|_| vec![0.1; COLUMNS.len()]).collect(),
+            z,
+        }
+    };
+    let e = verdem::analysis::ensemble::merge(&[flat(1e308), flat(1.5e308)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the merge of 2 replicas: nu at z = 0.5 is inf, not a finite number"),
+        "{e}"
+    );
+    assert!(verdem::analysis::ensemble::merge(&[flat(1e100), flat(1.5e100)]).is_ok());
+}

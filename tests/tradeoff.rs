@@ -391,3 +391,88 @@ fn the_ordered_gather_bounds_what_a_non_deterministic_step_could_save() {
         );
     }
 }
+
+/// `verdem tradeoff --table` on a table without its reference row is an error naming the
+/// file and the row, not an empty table.
+#[test]
+fn a_table_without_its_reference_row_is_refused() {
+    let golden = common::root().join("golden/tradeoff/tradeoff.csv");
+    let text = std::fs::read_to_string(&golden).unwrap();
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("reference,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(without.lines().count() + 1, text.lines().count());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.csv");
+    std::fs::write(&path, without).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .current_dir(common::root())
+        .arg("tradeoff")
+        .arg("--table")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("{}: no `reference` row", path.display())),
+        "{err}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let e = tradeoff::read_csv(text.lines().next().unwrap(), &path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no `reference` row") && e.contains("no row"),
+        "{e}"
+    );
+}
+
+/// Degrees of freedom that are negative or not finite, and other fields out of their range,
+/// are refused naming the file, the line and the field.
+#[test]
+fn degrees_of_freedom_out_of_range_are_refused_with_file_line_and_field() {
+    let golden = common::root().join("golden/tradeoff/tradeoff.csv");
+    let text = std::fs::read_to_string(&golden).unwrap();
+    let path = std::path::Path::new("t.csv");
+    assert!(tradeoff::read_csv(&text, path).is_ok());
+    // line 3, the control: its vx degrees of freedom (field 11) and its first standard error
+    let with = |from: &str, to: &str| {
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        assert!(lines[2].contains(from), "{}", lines[2]);
+        lines[2] = lines[2].replacen(from, to, 1);
+        lines.join("\n")
+    };
+    for (to, says) in [
+        (
+            ",-5,true,",
+            "t.csv: line 3: field 11 (vx_dof) is -5: it must be 0 or more",
+        ),
+        (
+            ",NaN,true,",
+            "t.csv: line 3: field 11 (vx_dof) is not finite: \"NaN\"",
+        ),
+        (
+            ",inf,true,",
+            "t.csv: line 3: field 11 (vx_dof) is not finite: \"inf\"",
+        ),
+    ] {
+        let e = tradeoff::read_csv(&with(",5,true,", to), path)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{to}: {e}");
+    }
+    let e = tradeoff::read_csv(&with(",6.42251135311506e-4,", ",-6.4e-4,"), path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("t.csv: line 3: field 10 (vx_se) is -0.00064: it must be 0 or more"),
+        "{e}"
+    );
+}

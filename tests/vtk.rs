@@ -386,3 +386,51 @@ fn a_resumed_run_continues_the_time_series() {
         .collect();
     assert_eq!(collection(&dir.path().join(format!("{name}.pvd"))), times);
 }
+
+/// A save with its `.data` but not its `.fstat` is an error naming the missing file; with
+/// `--skip-incomplete` it is skipped with a warning naming it and the others are converted.
+#[test]
+fn an_incomplete_save_is_said_or_skipped_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["data", "fstat"] {
+        let file = format!("Mercury_out.{ext}.0000");
+        std::fs::copy(
+            common::data(&format!("outputs_example/{file}")),
+            dir.path().join(&file),
+        )
+        .unwrap();
+    }
+    std::fs::copy(
+        dir.path().join("Mercury_out.data.0000"),
+        dir.path().join("Mercury_out.data.0001"),
+    )
+    .unwrap();
+    let base = dir.path().join("Mercury_out");
+    let out = Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .arg("vtk")
+        .arg(&base)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("Mercury_out.fstat.0001: missing (save 1 has ")
+            && err.contains("--skip-incomplete"),
+        "{err}"
+    );
+    assert!(!dir.path().join("Mercury_out.pvd").exists());
+    let o = common::verdem_ok([
+        "vtk".as_ref(),
+        base.as_os_str(),
+        "--skip-incomplete".as_ref(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: save 1 skipped: ") && err.contains("Mercury_out.fstat.0001"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("1 saves written"));
+    let pvd = std::fs::read_to_string(dir.path().join("Mercury_out.pvd")).unwrap();
+    assert!(pvd.contains("Mercury_out.0000.vtu") && !pvd.contains("Mercury_out.0001.vtu"));
+    assert!(!dir.path().join("Mercury_out.0001.vtu").exists());
+}

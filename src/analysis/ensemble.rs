@@ -38,11 +38,16 @@ pub fn merge(replicas: &[Table]) -> anyhow::Result<Table> {
             se[k][c] = standard_error(&values);
         }
     }
-    Ok(Table {
+    let merged = Table {
         z: first.z.clone(),
         mean,
         se,
-    })
+    };
+    merged.ensure_finite(
+        &format!("the merge of {} replicas", replicas.len()),
+        "the replicas' values are too large for their mean and spread",
+    )?;
+    Ok(merged)
 }
 
 /// The coverage test of one benchmark profile over the core slices.

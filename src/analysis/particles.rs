@@ -112,11 +112,20 @@ fn draw(
     let scale = (plot_w / lx).min(plot_h / lz);
     let (cx, cz) = (0.5 * (lo.x + hi.x), 0.5 * (lo.z + hi.z));
     let (half_x, half_z) = (0.5 * plot_w / scale, 0.5 * plot_h / scale);
+    let axes = (cx - half_x..cx + half_x, cz - half_z..cz + half_z);
+    anyhow::ensure!(
+        [&axes.0, &axes.1]
+            .iter()
+            .all(|r| (r.end - r.start).is_finite() && r.end > r.start),
+        "the box {:?}..{:?} gives axes that are not finite: cannot draw it",
+        lo.as_slice(),
+        hi.as_slice()
+    );
     let mut chart = ChartBuilder::on(&view)
         .margin(margin)
         .x_label_area_size(x_labels)
         .y_label_area_size(y_labels)
-        .build_cartesian_2d(cx - half_x..cx + half_x, cz - half_z..cz + half_z)?;
+        .build_cartesian_2d(axes.0, axes.1)?;
     chart
         .configure_mesh()
         .disable_mesh()

@@ -176,6 +176,41 @@ impl Outcome {
     pub fn wall_per_time(&self) -> f64 {
         self.wall_seconds / self.simulated()
     }
+
+    /// The first of its numbers (what [`csv`] and [`replicas_csv`] write) that is NaN or
+    /// infinite, named; `None` when all are finite.
+    pub fn first_non_finite(&self) -> Option<(String, f64)> {
+        let times = [
+            ("dt", self.dt),
+            ("CPU time", self.cpu_seconds),
+            ("wall time", self.wall_seconds),
+            ("restitution error", self.restitution_error),
+        ];
+        let core = |c: &[CoreMean], of: &str| {
+            c.iter()
+                .zip(FIELDS)
+                .flat_map(|(m, (field, _))| {
+                    [
+                        ("core mean", m.mean),
+                        ("standard error", m.se),
+                        ("dof", m.dof),
+                    ]
+                    .map(|(what, x)| (format!("{what} of {field}{of}"), x))
+                })
+                .collect::<Vec<_>>()
+        };
+        times
+            .into_iter()
+            .map(|(what, x)| (what.to_string(), x))
+            .chain(core(&self.core, ""))
+            .chain(
+                self.replica_core
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(k, c)| core(c, &format!(" in replica {k}"))),
+            )
+            .find(|(_, x)| !x.is_finite())
+    }
 }
 
 /// The core means of independent replicas merged. One replica: its own. R ≥ 2: their mean,
@@ -346,6 +381,12 @@ pub fn run(
             core,
             replica_core: parts,
         };
+        if let Some((what, x)) = o.first_non_finite() {
+            bail!(
+                "{}: the {what} is {x}, not a finite number; nothing written",
+                o.name
+            );
+        }
         done(&o);
         outcomes.push(o);
     }
@@ -467,8 +508,24 @@ pub fn call(biases: &[Bias], same_bits: bool, resolution: f64) -> Call {
     }
 }
 
+/// `x` as a percentage with two decimals; "undefined" when it is not a finite number (a
+/// relative size against a reference of 0).
 fn percent(x: f64) -> String {
-    format!("{:.2} %", 100.0 * x)
+    if x.is_finite() {
+        format!("{:.2} %", 100.0 * x)
+    } else {
+        "undefined".into()
+    }
+}
+
+/// `a / b` with two decimals; "undefined" when it is not a finite number.
+fn ratio(a: f64, b: f64) -> String {
+    let r = a / b;
+    if r.is_finite() {
+        format!("{r:.2}")
+    } else {
+        "undefined".into()
+    }
 }
 
 impl fmt::Display for Call {
@@ -594,6 +651,8 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
                     "—".to_string()
                 } else if same {
                     "0 (same bits)".to_string()
+                } else if !b.relative().is_finite() {
+                    format!("undefined (the scale is {}){mark}", b.scale)
                 } else {
                     format!(
                         "{:+.2} ± {}{mark}",
@@ -617,13 +676,13 @@ pub fn markdown(outcomes: &[Outcome], wall_speed: f64, resolution: f64) -> Strin
             judged(&b, same, resolution, control)
         };
         s.push_str(&format!(
-            "| {} | {:.3e} | {:.0} | {:.3} | {:.2} | {:.2} | {:+.2e} | {} | {} | {} |\n",
+            "| {} | {:.3e} | {:.0} | {:.3} | {} | {} | {:+.2e} | {} | {} | {} |\n",
             o.name,
             o.dt,
             o.steps_per_time(),
             o.cpu_per_time(),
-            o.cpu_per_time() / reference.cpu_per_time(),
-            o.wall_per_time() / reference.wall_per_time(),
+            ratio(o.cpu_per_time(), reference.cpu_per_time()),
+            ratio(o.wall_per_time(), reference.wall_per_time()),
             o.restitution_error,
             cells.join(" | "),
             if same { "yes" } else { "no" },
@@ -696,10 +755,19 @@ fn push_core(s: &mut String, core: &[CoreMean]) {
 }
 
 /// Reads what [`csv`] wrote (the variant's name is all before the other fields, commas
-/// included); `path` names the file in errors.
+/// included); `path` names the file in errors, with the line and the field: a field that is
+/// not a number, is not finite or is out of its range (dt not positive; CPU and wall seconds,
+/// standard errors and degrees of freedom negative; no step or replica), and a table without
+/// the [`REFERENCE`] row every bias is measured against.
 pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
     let mut out = Vec::new();
     let columns = 8 + 4 * FIELDS.len();
+    let names: Vec<String> =
+        core_header("variant,dt,steps,replicas,cpu_seconds,wall_seconds,restitution_error,hash")
+            .trim_end()
+            .split(',')
+            .map(String::from)
+            .collect();
     for (n, line) in text.lines().enumerate().skip(1) {
         let at = |what: &str| format!("{}: line {}: {what}", path.display(), n + 1);
         // the variant's name may hold commas: the other fields are the last ones
@@ -708,44 +776,84 @@ pub fn read_csv(text: &str, path: &Path) -> anyhow::Result<Vec<Outcome>> {
         if v.len() != columns {
             bail!(at(&format!("{} fields, expected {columns}", v.len())));
         }
-        let num = |k: usize| -> anyhow::Result<f64> {
+        let field = |k: usize| format!("field {} ({})", k + 1, names[k]);
+        // a finite number; `least` the smallest it may be, and whether that bound is allowed
+        let num = |k: usize, least: Option<(f64, bool)>| -> anyhow::Result<f64> {
             let x: f64 = v[k]
                 .parse()
-                .with_context(|| at(&format!("field {} is not a number: {:?}", k + 1, v[k])))?;
+                .with_context(|| at(&format!("{} is not a number: {:?}", field(k), v[k])))?;
             if !x.is_finite() {
-                bail!(at(&format!("field {} is not finite", k + 1)));
+                bail!(at(&format!("{} is not finite: {:?}", field(k), v[k])));
+            }
+            match least {
+                Some((bound, true)) if x < bound => bail!(at(&format!(
+                    "{} is {x}: it must be {bound} or more",
+                    field(k)
+                ))),
+                Some((bound, false)) if x <= bound => bail!(at(&format!(
+                    "{} is {x}: it must be above {bound}",
+                    field(k)
+                ))),
+                _ => Ok(x),
+            }
+        };
+        let int = |k: usize| -> anyhow::Result<u64> {
+            let x: u64 = v[k]
+                .parse()
+                .with_context(|| at(&format!("{} is not a count: {:?}", field(k), v[k])))?;
+            if x == 0 {
+                bail!(at(&format!("{} is 0: it must be 1 or more", field(k))));
             }
             Ok(x)
         };
-        let int = |k: usize| -> anyhow::Result<u64> {
-            v[k].parse()
-                .with_context(|| at(&format!("field {} is not a count: {:?}", k + 1, v[k])))
-        };
+        let non_negative = Some((0.0, true));
         let core = (0..FIELDS.len())
             .map(|f| {
                 let k = 8 + 4 * f;
                 Ok(CoreMean {
-                    mean: num(k)?,
-                    se: num(k + 1)?,
-                    dof: num(k + 2)?,
-                    long_enough: v[k + 3]
-                        .parse()
-                        .with_context(|| at(&format!("field {} is not true/false", k + 4)))?,
+                    mean: num(k, None)?,
+                    se: num(k + 1, non_negative)?,
+                    dof: num(k + 2, non_negative)?,
+                    long_enough: v[k + 3].parse().with_context(|| {
+                        at(&format!(
+                            "{} is not true/false: {:?}",
+                            field(k + 3),
+                            v[k + 3]
+                        ))
+                    })?,
                 })
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
         out.push(Outcome {
             name: v[0].to_string(),
-            dt: num(1)?,
+            dt: num(1, Some((0.0, false)))?,
             steps: int(2)?,
             replicas: int(3)?,
-            cpu_seconds: num(4)?,
-            wall_seconds: num(5)?,
-            restitution_error: num(6)?,
+            cpu_seconds: num(4, non_negative)?,
+            wall_seconds: num(5, non_negative)?,
+            restitution_error: num(6, None)?,
             hash: v[7].to_string(),
             core,
             replica_core: Vec::new(),
         });
+    }
+    if !out.iter().any(|o| o.name == REFERENCE) {
+        bail!(
+            "{}: no `{REFERENCE}` row: every bias is measured against the reference variant's \
+             row, and the table has {}",
+            path.display(),
+            if out.is_empty() {
+                "no row".to_string()
+            } else {
+                format!(
+                    "only {}",
+                    out.iter()
+                        .map(|o| format!("`{}`", o.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        );
     }
     Ok(out)
 }
@@ -767,6 +875,28 @@ mod tests {
             core: Vec::new(),
             replica_core: Vec::new(),
         }
+    }
+
+    #[test]
+    fn a_number_that_is_not_finite_is_named() {
+        let finite = CoreMean {
+            mean: 1.0,
+            se: 0.1,
+            dof: 4.0,
+            long_enough: true,
+        };
+        let mut o = outcome(REFERENCE, "abc");
+        o.core = vec![finite; FIELDS.len()];
+        o.replica_core = vec![vec![finite; FIELDS.len()]; 2];
+        assert_eq!(o.first_non_finite(), None);
+        o.replica_core[1][2].se = f64::INFINITY;
+        let (what, x) = o.first_non_finite().unwrap();
+        assert_eq!(
+            (what.as_str(), x),
+            ("standard error of T in replica 1", f64::INFINITY)
+        );
+        o.core[0].mean = f64::NAN;
+        assert_eq!(o.first_non_finite().unwrap().0, "core mean of vx");
     }
 
     #[test]

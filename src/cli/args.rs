@@ -1,9 +1,10 @@
 //! Arguments and value parsers shared by several commands.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
+use verdem::analysis::cg::{self, Series};
 use verdem::case::Case;
 use verdem::engine::{self, Overrides};
 use verdem::scene;
@@ -72,6 +73,26 @@ impl Common {
         }
         Ok((case, engine))
     }
+}
+
+/// The saves of the series `base` (`DIR/NAME`) for a command that reads both files of every
+/// save: a save with one of them only is an error naming the missing file, or with
+/// `skip_incomplete` (`--skip-incomplete`) is skipped with a warning naming it.
+pub fn complete_series(base: &Path, skip_incomplete: bool) -> anyhow::Result<Series> {
+    let (series, incomplete) = Series::scan(base)?;
+    if incomplete.is_empty() {
+        return Ok(series);
+    }
+    if !skip_incomplete {
+        anyhow::bail!(
+            "{} (--skip-incomplete skips such saves)",
+            cg::incomplete_saves(&incomplete)
+        );
+    }
+    for save in &incomplete {
+        eprintln!("warning: save {} skipped: {save}", save.save);
+    }
+    Ok(series)
 }
 
 /// A count of one or more (threads, ranks, rounds, slices, blocks, steps between saves).

@@ -7,7 +7,7 @@ use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
 use verdem::state::memory;
 
-use super::args::{count, named, positive};
+use super::args::{complete_series, count, named, positive};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -38,6 +38,10 @@ pub struct Args {
     /// Blocks of saves for the standard errors.
     #[arg(long, default_value_t = CgOptions::default().blocks, value_parser = count::<usize>)]
     blocks: usize,
+    /// Skip, with a warning naming each, the saves that have a `.data` or a `.fstat` file only
+    /// (without it such a save is an error).
+    #[arg(long)]
+    skip_incomplete: bool,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -54,13 +58,13 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         blocks: a.blocks,
         ..saves
     };
+    let series = complete_series(&a.base, a.skip_incomplete)?;
     // Each save's raw fields and each block's profiles: some 64 numbers a slice.
-    let saves = cg::Series::find(&a.base).map_or(1, |s| s.saves.len());
     memory::check(
-        &format!("--slices {} over {saves} saves", a.slices),
-        a.slices as f64 * 64.0 * 8.0 * (saves + a.blocks) as f64,
+        &format!("--slices {} over {} saves", a.slices, series.saves.len()),
+        a.slices as f64 * 64.0 * 8.0 * (series.saves.len() + a.blocks) as f64,
     )?;
-    let (_, report) = cg::write_all(&a.base, &o)?;
+    let (_, report) = cg::write_series(&series, &o)?;
     print!("{report}");
     Ok(Finished::Done)
 }

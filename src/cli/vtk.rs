@@ -4,10 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 
-use verdem::analysis::cg::{CgOptions, Series};
+use verdem::analysis::cg::CgOptions;
 use verdem::case::Case;
 use verdem::io::{mercury, vtk};
 
+use super::args::complete_series;
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -19,6 +20,10 @@ pub struct Args {
     /// Case file telling which particles are walls (default: the benchmark's, ids 1-480).
     #[arg(long)]
     case: Option<PathBuf>,
+    /// Skip, with a warning naming each, the saves that have a `.data` or a `.fstat` file only
+    /// (without it such a save is an error).
+    #[arg(long)]
+    skip_incomplete: bool,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -26,7 +31,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         Some(c) => CgOptions::for_case(&Case::load(c)?).walls,
         None => CgOptions::default().walls,
     };
-    let series = Series::find(&a.base)?;
+    let series = complete_series(&a.base, a.skip_incomplete)?;
     let mut out = vtk::Series::new(&series.dir, &series.name);
     for &k in &series.saves {
         let path = |ext| mercury::save_path(&series.dir, &series.name, ext, k);

@@ -399,8 +399,9 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
         .judged_if(energy.len() >= 4)
         .described(
             format!(
-                "linear change {:+.2} % over the saves, {t:+.2} standard errors",
-                100.0 * change
+                "linear change {:+.2} % over the saves, {:+.2} standard errors",
+                Shown(100.0 * change),
+                Shown(t)
             ),
             "|trend| < 3 standard errors (reported only with fewer than 4 blocks)".into(),
         ),
@@ -460,8 +461,8 @@ pub fn report(p: &Profiles, checks: &[Check]) -> String {
         let independent = block_len >= 2.0 * tau;
         format!(
             "integrated autocorrelation time {:.2} saves (shear), {:.2} (kinetic energy): blocks {} independent (block length {} 2 tau)",
-            p.tau_shear,
-            p.tau_energy,
+            Shown(p.tau_shear),
+            Shown(p.tau_energy),
             if independent { "are" } else { "are NOT" },
             if independent { ">=" } else { "<" },
         )

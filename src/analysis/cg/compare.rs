@@ -15,7 +15,8 @@ use super::{core_window, FIELDS};
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
     pub name: String,
-    /// χ²/dof of each profile of [`FIELDS`] against the reference, core slices only.
+    /// χ²/dof of each profile of [`FIELDS`] against the reference, core slices only; NaN
+    /// (undefined) when neither table has an error bar on that profile there.
     pub chi2: [f64; 5],
     /// Σ(a − ref) / Σ|ref| of each profile over the core slices (dimensionless, signed).
     pub rel_mean: [f64; 5],
@@ -41,7 +42,18 @@ fn relative_mean_difference(a: &Table, b: &Table, col: usize, window: (f64, f64)
     }
 }
 
-/// Compares each of `others` with `reference` over the core of the reference's grid.
+/// Whether `a` or `b` has an error bar in column `col` at a grid point with z in `window`: a
+/// combined variance se_a² + se_b² above 0 (what [`chi2`] divides by).
+fn has_error_bars(a: &Table, b: &Table, col: usize, window: (f64, f64)) -> bool {
+    (0..a.z.len()).any(|k| {
+        (window.0..=window.1).contains(&a.z[k]) && a.se[k][col].powi(2) + b.se[k][col].powi(2) > 0.0
+    })
+}
+
+/// Compares each of `others` with `reference` over the core of the reference's grid. A χ² is
+/// undefined (NaN) where neither table has error bars; an error names the table and the
+/// profile when a result that should be a number is not a finite one (values too large to
+/// square or add).
 pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<Vec<Comparison>> {
     let window = core_window(&reference.grid()?);
     others
@@ -49,13 +61,39 @@ pub fn compare(reference: &Table, others: &[(String, Table)]) -> anyhow::Result<
         .map(|(name, t)| {
             let mut c = Comparison {
                 name: name.clone(),
-                chi2: [0.0; 5],
+                chi2: [f64::NAN; 5],
                 rel_mean: [0.0; 5],
                 vx_shape: shape(t, reference, FIELDS[0].1, window)?,
             };
-            for (f, &(_, col)) in FIELDS.iter().enumerate() {
-                c.chi2[f] = chi2(t, reference, col, window)?;
+            let too_large = |field: &str, what: &str, v: f64| {
+                anyhow::anyhow!(
+                    "{name}: the {what} of {field} against the reference is {v}, not a finite \
+                     number: the tables' values are too large to compare"
+                )
+            };
+            for (f, &(field, col)) in FIELDS.iter().enumerate() {
+                if has_error_bars(t, reference, col, window) {
+                    c.chi2[f] = chi2(t, reference, col, window)?;
+                    if !c.chi2[f].is_finite() {
+                        return Err(too_large(field, "χ²", c.chi2[f]));
+                    }
+                }
                 c.rel_mean[f] = relative_mean_difference(t, reference, col, window);
+                if !c.rel_mean[f].is_finite() {
+                    return Err(too_large(
+                        field,
+                        "difference of the core means",
+                        c.rel_mean[f],
+                    ));
+                }
+            }
+            for (what, v) in [
+                ("χ² less the offset", c.vx_shape.chi2),
+                ("common offset", c.vx_shape.offset),
+            ] {
+                if v.is_infinite() {
+                    return Err(too_large("vx", what, v));
+                }
             }
             Ok(c)
         })
@@ -89,7 +127,7 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
             r.name,
             r.chi2
                 .iter()
-                .map(|c| format!("{c:.2}"))
+                .map(|c| format!("{:.2}", Shown(*c)))
                 .collect::<Vec<_>>()
                 .join(" | "),
             r.rel_mean
@@ -99,6 +137,40 @@ pub fn markdown(reference: &str, rows: &[Comparison]) -> String {
                 .join(" | "),
             Shown(r.vx_shape.chi2),
             Shown(r.vx_shape.offset)
+        );
+    }
+    for r in rows {
+        let undefined: Vec<&str> = FIELDS
+            .iter()
+            .zip(&r.chi2)
+            .filter(|(_, c)| c.is_nan())
+            .map(|((n, _), _)| *n)
+            .collect();
+        if undefined.is_empty() {
+            continue;
+        }
+        let (f, largest) = r
+            .rel_mean
+            .iter()
+            .enumerate()
+            .filter(|(f, _)| undefined.contains(&FIELDS[*f].0))
+            // the first of equal differences
+            .rev()
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .expect("an undefined χ²");
+        let which = if undefined.len() == FIELDS.len() {
+            "χ² undefined".to_string()
+        } else {
+            format!("χ² of {} undefined", undefined.join(", "))
+        };
+        let _ = write!(
+            s,
+            "\n`{}`: {which}: no error bars in either table. Without them no difference can be \
+             told from noise: no pass. What can be said: the largest difference of the core \
+             means there is {:+.2} % ({}).\n",
+            r.name,
+            100.0 * largest,
+            FIELDS[f].0
         );
     }
     s
@@ -149,11 +221,26 @@ mod tests {
     }
 
     #[test]
-    fn profiles_without_errors_give_no_offset_and_no_nan() {
+    fn profiles_without_errors_give_no_chi2_no_offset_and_no_nan() {
         let rows = compare(&flat(1.0, 0.0), &[("exact".into(), flat(1.5, 0.0))]).unwrap();
         assert!(rows[0].vx_shape.offset.is_nan(), "{:?}", rows[0]);
+        assert!(rows[0].chi2.iter().all(|c| c.is_nan()), "{:?}", rows[0]);
         let md = markdown("ref", &rows);
+        assert!(md.contains("| exact | undefined | undefined |"), "{md}");
         assert!(md.contains("| undefined | undefined |"), "{md}");
-        assert!(!md.contains("NaN"), "{md}");
+        assert!(
+            md.contains("`exact`: χ² undefined: no error bars in either table."),
+            "{md}"
+        );
+        assert!(md.contains("+50.00 % (vx)"), "{md}");
+        assert!(!md.contains("NaN") && !md.contains("0.00 |"), "{md}");
+    }
+
+    #[test]
+    fn values_too_large_to_square_are_refused() {
+        let e = compare(&flat(1.0, 1e-100), &[("huge".into(), flat(1e200, 1e-100))])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("huge: the χ² of vx") && e.contains("inf"), "{e}");
     }
 }

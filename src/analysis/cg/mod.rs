@@ -11,6 +11,7 @@ pub mod kernel;
 pub mod plot;
 pub mod table;
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
@@ -147,9 +148,41 @@ pub struct Series {
     pub saves: Vec<u64>,
 }
 
+/// A save of a series with one of its two files only.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Incomplete {
+    pub save: u64,
+    /// The file that is there and the one that is not.
+    pub present: PathBuf,
+    pub missing: PathBuf,
+}
+
+impl std::fmt::Display for Incomplete {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: missing (save {} has {} only)",
+            self.missing.display(),
+            self.save,
+            self.present.display()
+        )
+    }
+}
+
 impl Series {
-    /// Finds the saves of `base` = `DIR/NAME`.
+    /// Finds the saves of `base` = `DIR/NAME`; a save with one of its two files only is an
+    /// error naming the missing file ([`Series::scan`] lists them instead).
     pub fn find(base: &Path) -> anyhow::Result<Series> {
+        let (series, incomplete) = Series::scan(base)?;
+        if !incomplete.is_empty() {
+            bail!("{}", incomplete_saves(&incomplete));
+        }
+        Ok(series)
+    }
+
+    /// Finds the saves of `base` = `DIR/NAME` that have both files, and the saves that have
+    /// one of them only (by save number); an error when no save has both.
+    pub fn scan(base: &Path) -> anyhow::Result<(Series, Vec<Incomplete>)> {
         let dir = base
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
@@ -160,34 +193,69 @@ impl Series {
             .and_then(|n| n.to_str())
             .with_context(|| format!("{}: not a series base name", base.display()))?
             .to_string();
-        let prefix = format!("{name}.data.");
-        let mut saves = Vec::new();
+        let (mut data, mut fstat) = (BTreeSet::new(), BTreeSet::new());
         for entry in
             std::fs::read_dir(&dir).with_context(|| format!("{}: cannot list", dir.display()))?
         {
             let file = entry?.file_name();
-            let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            let Some(file) = file.to_str() else {
                 continue;
             };
-            if let Ok(k) = rest.parse::<u64>() {
-                if dir.join(format!("{name}.fstat.{rest}")).exists() {
-                    saves.push(k);
-                }
+            let number = |ext: &str| {
+                file.strip_prefix(&format!("{name}.{ext}."))?
+                    .parse::<u64>()
+                    .ok()
+            };
+            if let Some(k) = number("data") {
+                data.insert(k);
+            } else if let Some(k) = number("fstat") {
+                fstat.insert(k);
             }
         }
-        saves.sort_unstable();
+        let path = |ext: &str, k: u64| mercury::save_path(&dir, &name, ext, k);
+        let incomplete: Vec<Incomplete> = data
+            .symmetric_difference(&fstat)
+            .map(|&k| {
+                let (present, missing) = if data.contains(&k) {
+                    ("data", "fstat")
+                } else {
+                    ("fstat", "data")
+                };
+                Incomplete {
+                    save: k,
+                    present: path(present, k),
+                    missing: path(missing, k),
+                }
+            })
+            .collect();
+        let saves: Vec<u64> = data.intersection(&fstat).copied().collect();
         if saves.is_empty() {
             bail!(
                 "{}: no {name}.data.NNNN with a matching .fstat.NNNN",
                 dir.display()
             );
         }
-        Ok(Series { dir, name, saves })
+        Ok((Series { dir, name, saves }, incomplete))
     }
 
     fn path(&self, ext: &str, k: u64) -> PathBuf {
         mercury::save_path(&self.dir, &self.name, ext, k)
     }
+}
+
+/// The incomplete saves `list` in words, for an error or a warning: the first three (the
+/// missing file of each), and how many more there are.
+pub fn incomplete_saves(list: &[Incomplete]) -> String {
+    let mut s = list
+        .iter()
+        .take(3)
+        .map(Incomplete::to_string)
+        .collect::<Vec<_>>()
+        .join("; ");
+    if list.len() > 3 {
+        s.push_str(&format!("; and {} more incomplete saves", list.len() - 3));
+    }
+    s
 }
 
 /// Profiles with standard errors.
@@ -335,8 +403,35 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
                     head.rows.len()
                 );
             }
+            let (data_path, fstat_path) = (series.path("data", k), series.path("fstat", k));
+            usable(
+                &data,
+                &fstat,
+                &is_wall,
+                &domain,
+                o.density,
+                &data_path,
+                &fstat_path,
+            )?;
             let raw = raw_fields(&data, &fstat, &is_wall, &domain, &grid, kernel, o.density);
-            Ok((raw, wall_forces(&fstat, &is_wall, &data)))
+            if let Some((field, at, v)) = first_non_finite(&raw) {
+                bail!(
+                    "{}: the coarse-grained {field} at z = {} is {v}: the save's numbers add up \
+                     beyond the largest number{}",
+                    data_path.display(),
+                    grid.z(at),
+                    fastest(&data, &is_wall)
+                );
+            }
+            let forces = wall_forces(&fstat, &is_wall, &data);
+            if forces.iter().any(|f| !f.iter().all(|c| c.is_finite())) {
+                bail!(
+                    "{}: the force on a wall is not a finite number: its contacts' forces add up \
+                     beyond the largest number",
+                    fstat_path.display()
+                );
+            }
+            Ok((raw, forces))
         })
         .collect();
     let mut per_save = Vec::with_capacity(saves.len());
@@ -385,7 +480,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     };
     let tau_shear = integrated_autocorrelation(&series_of(&|d| d.shear));
     let tau_energy = integrated_autocorrelation(&series_of(&|d| d.kinetic.trace()));
-    Ok(Profiles {
+    let profiles = Profiles {
         grid,
         kernel,
         saves,
@@ -402,7 +497,115 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
         tau_shear,
         tau_energy,
         trusted: vec![true; COLUMNS.len()],
+    };
+    Table::of(&profiles).ensure_finite(
+        &format!(
+            "{}: the profiles of saves {first} to {last}",
+            series.dir.join(&series.name).display()
+        ),
+        "the saves' numbers are too large for the averages and their spread",
+    )?;
+    Ok(profiles)
+}
+
+/// Refuses a save whose numbers the coarse-graining cannot carry, naming the file, the line or
+/// contact, the column and the value: a free particle whose mass (from its radius and
+/// `density`, mass/length³) or whose mass times the square of a velocity component (the
+/// momentum flux it adds, mass·length²/time²) is not a finite number, and a contact whose
+/// force or whose force times its branch (f⊗l, force·length) is not.
+fn usable(
+    data: &mercury::DataFile,
+    fstat: &mercury::FstatFile,
+    is_wall: &dyn Fn(usize) -> bool,
+    domain: &Domain,
+    density: f64,
+    data_path: &Path,
+    fstat_path: &Path,
+) -> anyhow::Result<()> {
+    for (i, p) in data.rows.iter().enumerate() {
+        if is_wall(i) {
+            continue;
+        }
+        let m = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3) * density;
+        if !m.is_finite() {
+            bail!(
+                "{}:{}: particle {i}: column 7 (radius): {:e} is too large to coarse-grain: its \
+                 mass is not a finite number",
+                data_path.display(),
+                p.line,
+                p.radius
+            );
+        }
+        for (c, name) in ["vx", "vy", "vz"].iter().enumerate() {
+            let v = p.v[c];
+            if !(m * v * v).is_finite() {
+                bail!(
+                    "{}:{}: particle {i}: column {} ({name}): {v:e} is too large to coarse-grain: \
+                     its momentum flux m·{name}² is not a finite number",
+                    data_path.display(),
+                    p.line,
+                    4 + c
+                );
+            }
+        }
+    }
+    for (k, r) in fstat.rows.iter().enumerate() {
+        let f = r.fn_signed * r.n + r.ft * r.t;
+        let start = if is_wall(r.j) { r.c } else { data.rows[r.j].x };
+        let branch = domain.min_image(data.rows[r.i].x - start);
+        let tensor = f * branch.transpose();
+        if !(f.iter().chain(tensor.iter()).all(|x| x.is_finite())) {
+            bail!(
+                "{}: contact {} (particles {} and {}): fn = {:e}, ft = {:e}, branch length {:e}: \
+                 too large to coarse-grain: its force or its f⊗l is not a finite number",
+                fstat_path.display(),
+                k + 1,
+                r.i,
+                r.j,
+                r.fn_signed,
+                r.ft,
+                branch.norm()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The first raw field of `raw` that is NaN or infinite: (its name, its grid point, the value).
+fn first_non_finite(raw: &Raw) -> Option<(&'static str, usize, f64)> {
+    (0..raw.nu.len()).find_map(|k| {
+        let fields: [(&'static str, Vec<f64>); 5] = [
+            ("volume fraction", vec![raw.nu[k]]),
+            ("density", vec![raw.rho[k]]),
+            ("momentum", raw.momentum[k].iter().copied().collect()),
+            ("momentum flux", raw.flux[k].iter().copied().collect()),
+            ("contact stress", raw.contact[k].iter().copied().collect()),
+        ];
+        fields.into_iter().find_map(|(name, values)| {
+            values
+                .into_iter()
+                .find(|v| !v.is_finite())
+                .map(|v| (name, k, v))
+        })
     })
+}
+
+/// The fastest free particle of a save (by its largest velocity component in magnitude) in
+/// words, for messages: "; the fastest: particle I (line L), largest velocity component V"
+/// (empty without free particles).
+fn fastest(data: &mercury::DataFile, is_wall: &dyn Fn(usize) -> bool) -> String {
+    data.rows
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !is_wall(*i))
+        .max_by(|a, b| a.1.v.amax().total_cmp(&b.1.v.amax()))
+        .map_or(String::new(), |(i, p)| {
+            format!(
+                "; the fastest: particle {i} (line {}), largest velocity component {:e}",
+                p.line,
+                p.v.amax()
+            )
+        })
 }
 
 /// Grid points of the core (see [`core_window`]).
@@ -451,8 +654,12 @@ pub fn csv(p: &Profiles) -> String {
 /// Coarse-grains `base` and writes `NAME.profiles.csv`, `NAME.profiles.png` and
 /// `NAME.checks.txt` beside it; returns the profiles and the checks' report.
 pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
-    let series = Series::find(base)?;
-    let p = coarse_grain(&series, o)?;
+    write_series(&Series::find(base)?, o)
+}
+
+/// As [`write_all`], for the saves of `series`.
+pub fn write_series(series: &Series, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
+    let p = coarse_grain(series, o)?;
     let out = |ext: &str| series.dir.join(format!("{}.{ext}", series.name));
     crate::io::atomic::write(&out("profiles.csv"), csv(&p).as_bytes())?;
     let mut report = checks::report(&p, &checks::run(&p, o.density));

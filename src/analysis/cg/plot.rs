@@ -68,9 +68,11 @@ pub fn panels_png(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::R
     // Drawn beside the target, then written durably in its place (`io::atomic`): an
     // interrupted run or a full disk never leaves half a picture or the scratch file.
     let tmp = path.with_extension("part.png");
-    let drawn = draw(panels, &tmp).and_then(|()| {
-        std::fs::read(&tmp).with_context(|| format!("{}: cannot read back", tmp.display()))
-    });
+    let drawn = draw(panels, &tmp)
+        .with_context(|| format!("{}: cannot draw", path.display()))
+        .and_then(|()| {
+            std::fs::read(&tmp).with_context(|| format!("{}: cannot read back", tmp.display()))
+        });
     // the scratch file goes whatever happened; a failure to remove it is not the error to report
     let _ = std::fs::remove_file(&tmp);
     crate::io::atomic::write(path, &drawn?)
@@ -83,28 +85,23 @@ fn draw(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> 
     let areas = root.split_evenly((1, panels.len()));
     let colours = [BLUE, RED, GREEN, MAGENTA, BLACK];
     for ((title, curves), area) in panels.iter().zip(areas.iter()) {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for c in curves {
-            for (v, s) in c.value.iter().zip(&c.se) {
-                lo = lo.min(v - 2.0 * s);
-                hi = hi.max(v + 2.0 * s);
-            }
-        }
-        if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-            hi = lo + 1.0;
-        }
-        let pad = 0.05 * (hi - lo);
-        let zmax = curves
-            .iter()
-            .flat_map(|c| c.z.iter().copied())
-            .fold(0.0, f64::max)
-            + 0.5;
+        let values = curves.iter().flat_map(|c| {
+            c.value
+                .iter()
+                .zip(&c.se)
+                .flat_map(|(v, s)| [v - 2.0 * s, v + 2.0 * s])
+        });
+        let (lo, hi) = extent(values).with_context(|| format!("panel {title}"))?;
+        let x = axis_range(lo, hi).with_context(|| format!("panel {title}"))?;
+        let (_, zmax) = extent(curves.iter().flat_map(|c| c.z.iter().copied()))
+            .with_context(|| format!("panel {title}: z"))?;
+        let zmax = zmax.max(0.0) + 0.5;
         let mut chart = ChartBuilder::on(area)
             .caption(title, ("sans-serif", 18))
             .margin(8)
             .x_label_area_size(36)
             .y_label_area_size(52)
-            .build_cartesian_2d(lo - pad..hi + pad, 0.0..zmax)?;
+            .build_cartesian_2d(x, 0.0..zmax)?;
         chart
             .configure_mesh()
             .x_labels(4)
@@ -143,6 +140,55 @@ fn draw(panels: &[(String, Vec<Curve<'_>>)], path: &Path) -> anyhow::Result<()> 
     }
     root.present()
         .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// The smallest and largest of `values` (in the values' units); an error naming the first
+/// value that is NaN or infinite, or when there is none.
+pub fn extent(values: impl IntoIterator<Item = f64>) -> anyhow::Result<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (k, v) in values.into_iter().enumerate() {
+        anyhow::ensure!(v.is_finite(), "value {} is {v}: cannot draw it", k + 1);
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    anyhow::ensure!(lo <= hi, "no value to draw");
+    Ok((lo, hi))
+}
+
+/// The range of a linear axis that shows the values from `lo` to `hi` (in the values' units)
+/// with a margin of 5 % of the width on each side: total and prompt for any input. A zero width
+/// is widened to ± 5 % of the value (± 0.5 about 0), a width below a millionth of the values'
+/// magnitude to that millionth (plotters' tick search needs a width well above the spacing of
+/// the numbers there); a margin beyond the largest number is cut at it. An error, never a
+/// range, for a bound that is NaN or infinite, and for values so far apart that the axis's
+/// width is not a finite number.
+pub fn axis_range(lo: f64, hi: f64) -> anyhow::Result<std::ops::Range<f64>> {
+    anyhow::ensure!(
+        lo.is_finite() && hi.is_finite(),
+        "cannot draw an axis from {lo} to {hi}: not finite"
+    );
+    let (lo, hi) = (lo.min(hi), lo.max(hi));
+    let magnitude = lo.abs().max(hi.abs());
+    let half = if hi == lo {
+        if magnitude == 0.0 {
+            0.5
+        } else {
+            0.05 * magnitude
+        }
+    } else {
+        (0.5 * hi - 0.5 * lo).max(1e-6 * magnitude)
+    };
+    let centre = 0.5 * lo + 0.5 * hi;
+    // a margin beyond the largest number is cut at it
+    let (a, b) = (
+        (centre - 1.1 * half).max(-f64::MAX),
+        (centre + 1.1 * half).min(f64::MAX),
+    );
+    anyhow::ensure!(
+        (b - a).is_finite() && b > a,
+        "cannot draw an axis from {lo:e} to {hi:e}: its width is beyond the largest number"
+    );
+    Ok(a..b)
 }
 
 /// The five benchmark profiles of one run.

@@ -38,6 +38,31 @@ impl Table {
         })
     }
 
+    /// The first number of the table that is NaN or infinite, as (its row from 0, the name of
+    /// its field as in the CSV's header, the number); `None` when all are finite.
+    pub fn first_non_finite(&self) -> Option<(usize, String, f64)> {
+        (0..self.z.len()).find_map(|k| {
+            let pairs = self.mean[k].iter().zip(&self.se[k]);
+            std::iter::once(self.z[k])
+                .chain(pairs.flat_map(|(v, e)| [*v, *e]))
+                .enumerate()
+                .find(|(_, v)| !v.is_finite())
+                .map(|(col, v)| (k, field_name(col), v))
+        })
+    }
+
+    /// An error when a number of the table is NaN or infinite, naming `what` the table is, the
+    /// field, its z and the number; `why` says what made it so.
+    pub fn ensure_finite(&self, what: &str, why: &str) -> anyhow::Result<()> {
+        match self.first_non_finite() {
+            None => Ok(()),
+            Some((k, field, v)) => anyhow::bail!(
+                "{what}: {field} at z = {} is {v}, not a finite number ({why}); nothing written",
+                self.z[k]
+            ),
+        }
+    }
+
     /// The CSV text: z, then every column of [`COLUMNS`] followed by its standard error.
     pub fn csv(&self) -> String {
         csv_table::write(
