@@ -611,6 +611,16 @@ fn replica_folders(out: &Path) -> anyhow::Result<Vec<u64>> {
     Ok(ks)
 }
 
+/// The TOML line `key = ratio`, or, for a ratio that is not finite (the replicas' own errors
+/// are 0), a comment saying it is undefined: the summary holds no non-finite number.
+fn ratio_line(key: &str, ratio: f64) -> String {
+    if ratio.is_finite() {
+        format!("{key} = {ratio}")
+    } else {
+        format!("# {key} undefined: the replicas' own errors are 0")
+    }
+}
+
 /// A merged ensemble.
 #[derive(Clone, Debug)]
 pub struct Merged {
@@ -658,21 +668,24 @@ impl Merged {
             let (lo, hi) = merge::wilson_interval(c.inside, c.pairs);
             let _ = writeln!(
                 s,
-                "\n[[{table}]]\nname = {:?}\ncore_mean = {:e}\ncore_se = {:e}\ncoverage = {}\ncoverage_interval = [{lo}, {hi}]\npairs = {}\nexpected_coverage = {}\nspread_over_block_error = {}",
+                "\n[[{table}]]\nname = {:?}\ncore_mean = {:e}\ncore_se = {:e}\ncoverage = {}\ncoverage_interval = [{lo}, {hi}]\npairs = {}\nexpected_coverage = {}\n{}",
                 c.field,
                 c.core_mean,
                 c.core_se,
                 c.fraction(),
                 c.pairs,
                 c.expected,
-                c.spread_ratio
+                ratio_line("spread_over_block_error", c.spread_ratio)
             );
         }
         for c in self.inrun.iter().flat_map(|(_, _, c)| c) {
             let _ = writeln!(
                 s,
-                "\n[[core_inrun]]\nname = {:?}\ninside = {}\nreplicas = {}\nspread_over_error = {}",
-                c.field, c.inside, c.replicas, c.spread_ratio
+                "\n[[core_inrun]]\nname = {:?}\ninside = {}\nreplicas = {}\n{}",
+                c.field,
+                c.inside,
+                c.replicas,
+                ratio_line("spread_over_error", c.spread_ratio)
             );
         }
         s
