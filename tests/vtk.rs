@@ -331,18 +331,24 @@ fn the_case_file_can_ask_for_vtk() {
     assert_eq!(collection(&out.join("shear_flow_steady.pvd")).len(), 2);
 }
 
-/// `verdem vtk` converts another code's series: MercuryDPM's own save 0 of the benchmark.
-#[test]
-fn verdem_vtk_converts_mercurydpm_saves() {
-    let dir = tempfile::tempdir().unwrap();
+/// Copies MercuryDPM's own save 0 of the benchmark (`Mercury_out.data.0000`, `.fstat.0000`)
+/// into `dir`.
+fn copy_mercury_save_0(dir: &Path) {
     for ext in ["data", "fstat"] {
         let file = format!("Mercury_out.{ext}.0000");
         std::fs::copy(
             common::data(&format!("outputs_example/{file}")),
-            dir.path().join(&file),
+            dir.join(&file),
         )
         .unwrap();
     }
+}
+
+/// `verdem vtk` converts another code's series: MercuryDPM's own save 0 of the benchmark.
+#[test]
+fn verdem_vtk_converts_mercurydpm_saves() {
+    let dir = tempfile::tempdir().unwrap();
+    copy_mercury_save_0(dir.path());
     let base = dir.path().join("Mercury_out");
     let o = common::verdem_ok(["vtk".as_ref(), base.as_os_str()]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("1 saves written"));
@@ -392,14 +398,7 @@ fn a_resumed_run_continues_the_time_series() {
 #[test]
 fn an_incomplete_save_is_said_or_skipped_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
-    for ext in ["data", "fstat"] {
-        let file = format!("Mercury_out.{ext}.0000");
-        std::fs::copy(
-            common::data(&format!("outputs_example/{file}")),
-            dir.path().join(&file),
-        )
-        .unwrap();
-    }
+    copy_mercury_save_0(dir.path());
     std::fs::copy(
         dir.path().join("Mercury_out.data.0000"),
         dir.path().join("Mercury_out.data.0001"),
