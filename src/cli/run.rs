@@ -343,7 +343,8 @@ fn print_contact_summary(case: &Case) {
 
 /// A flag raised by SIGINT, SIGTERM or SIGHUP ([`signals`]): a run then stops at the end of its
 /// block of steps and writes a checkpoint. A second signal ends the process at once with
-/// [`super::EXIT_INTERRUPTED`]; every file it has written is whole (written atomically) all the same.
+/// [`super::EXIT_INTERRUPTED`]; every file it has written is whole (written atomically) all the
+/// same.
 fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
     let stop = Arc::new(AtomicBool::new(false));
     signals::graceful(Graceful {
