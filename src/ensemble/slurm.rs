@@ -293,6 +293,28 @@ mod tests {
     }
 
     #[test]
+    fn a_stop_request_ends_the_pause_between_two_polls() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let o = Options {
+            sbatch_args: Vec::new(),
+            poll: Duration::from_secs(600),
+            stop: Some(Arc::clone(&stop)),
+        };
+        let started = Instant::now();
+        std::thread::scope(|s| {
+            s.spawn(|| pause(&o));
+            std::thread::sleep(Duration::from_millis(50));
+            stop.store(true, Ordering::Relaxed);
+        });
+        // within the 0.1 s slice, not after the 600 s poll (a loaded machine allowing)
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "{:?}",
+            started.elapsed()
+        );
+    }
+
+    #[test]
     fn quoting_survives_the_shell() {
         for a in ["plain-1.toml", "with space", "it's", "$HOME", ""] {
             let out = Command::new("sh")
