@@ -737,8 +737,8 @@ pub fn sweep(sizes: &[Size], configs: &[Config], rounds: usize) -> anyhow::Resul
 
 /// The peak resident memory (bytes) of this process's own address space (`VmHWM` in
 /// `/proc/self/status`): unlike `getrusage`'s, it starts afresh at `exec`, so that a process
-/// started by a large one (`vfork` and `exec`, as `std::process::Command` does) does not
-/// inherit its parent's peak. `None` where the file or the line is missing.
+/// started by a large one (`fork` and `exec`, as [`crate::child::spawn`] does) does not
+/// inherit its parent's resident memory. `None` where the file or the line is missing.
 pub fn own_peak_rss() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let kib: f64 = status
@@ -754,7 +754,8 @@ pub fn own_peak_rss() -> Option<f64> {
 
 /// The peak resident memory (bytes) of the largest of this process's waited-for descendants,
 /// from `getrusage(RUSAGE_CHILDREN)` (the kernel keeps the largest one's, not their sum; a
-/// child started by `vfork` and `exec` counts this process's own peak at that moment too);
+/// child started by `fork` and `exec` counts this process's resident memory at that moment
+/// too);
 /// `None` where it fails.
 pub fn children_peak_rss() -> Option<f64> {
     // SAFETY: getrusage writes one `rusage` into the zeroed struct it is given.

@@ -8,6 +8,7 @@
 pub mod analysis;
 pub mod bench;
 pub mod case;
+pub mod child;
 pub mod contact;
 pub mod engine;
 pub mod ensemble;

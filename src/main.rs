@@ -65,6 +65,11 @@ enum Command {
 }
 
 fn main() {
+    // first, before any thread starts (cli::signals)
+    if let Err(e) = cli::signals::install() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
     let outcome = match Cli::parse().command {
         Command::Run(a) => cli::run::exec(a),
         Command::Cg(a) => cli::cg::exec(a),

@@ -7,6 +7,7 @@ use std::process::Command;
 use anyhow::{bail, Context};
 use verdem::bench::{self, AtSize, Config, Size};
 use verdem::case::Case;
+use verdem::child::{self, OnParentDeath};
 use verdem::io::atomic;
 use verdem::scene;
 
@@ -213,17 +214,19 @@ fn probe_memory(z: &Size, c: &Config) -> anyhow::Result<f64> {
         }
     };
     let exe = std::env::current_exe().context("the path of the verdem program")?;
-    let out = Command::new(&exe)
-        .arg("bench")
-        .arg(&z.case.path)
-        .arg("--from")
-        .arg(&from)
-        .args(["--steps", &z.steps.min(PROBE_STEPS).to_string()])
-        .args(["--probe", &probe])
-        .arg("--out")
-        .arg(dir(&probe))
-        .output()
-        .with_context(|| format!("cannot start {}", exe.display()))?;
+    let out = child::output(
+        Command::new(&exe)
+            .arg("bench")
+            .arg(&z.case.path)
+            .arg("--from")
+            .arg(&from)
+            .args(["--steps", &z.steps.min(PROBE_STEPS).to_string()])
+            .args(["--probe", &probe])
+            .arg("--out")
+            .arg(dir(&probe)),
+        OnParentDeath::Kill,
+    )
+    .with_context(|| format!("cannot start {}", exe.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         bail!(

@@ -2,7 +2,7 @@
 //! merge their profiles with ensemble error bars and the coverage test of their own error bars.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -13,6 +13,7 @@ use verdem::ensemble::{self, local, slurm, Plan, ReplicaCommand};
 use verdem::io::lock::{self, FolderLock};
 
 use super::args::{count, named, non_negative, positive};
+use super::signals::{self, Graceful};
 use super::Finished;
 
 /// Where the replicas run.
@@ -233,12 +234,14 @@ fn absolute(p: &Path) -> anyhow::Result<PathBuf> {
         .with_context(|| format!("{}: cannot make the path absolute", p.display()))
 }
 
-/// A flag raised by SIGINT, SIGTERM or SIGHUP while waiting for Slurm: the job is then
-/// cancelled.
+/// A flag raised by SIGINT, SIGTERM or SIGHUP ([`signals`]) while waiting for Slurm: the job is
+/// then cancelled.
 fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
     let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-        .context("cannot install the signal handler")?;
+    signals::graceful(Graceful {
+        flag: Arc::clone(&stop),
+        notice: None,
+        second_exits: false,
+    })?;
     Ok(stop)
 }

@@ -12,6 +12,7 @@ pub mod hash;
 pub mod kinematics;
 pub mod peers;
 pub mod run;
+pub mod signals;
 pub mod tile;
 pub mod tradeoff;
 pub mod verify;

@@ -2,7 +2,7 @@
 //! bumpy-shear scene, coarse-grain its saves.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use anyhow::Context;
@@ -20,7 +20,8 @@ use verdem::state::Motion;
 use verdem::step::Engine;
 
 use super::args::{count, Common};
-use super::{Finished, EXIT_INTERRUPTED};
+use super::signals::{self, Graceful};
+use super::Finished;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -354,22 +355,20 @@ fn print_contact_summary(case: &Case) {
     println!("dt = {dt:e}");
 }
 
-/// A flag raised by SIGINT, SIGTERM or SIGHUP (ctrlc's `termination` feature): a run then stops
-/// at the end of its block of steps and writes a checkpoint. A second signal ends the process at
-/// once; every file it has written is whole (written atomically) all the same.
+/// A flag raised by SIGINT, SIGTERM or SIGHUP ([`signals`]): a run then stops at the end of its
+/// block of steps and writes a checkpoint. A second signal ends the process at once with
+/// [`super::EXIT_INTERRUPTED`]; every file it has written is whole (written atomically) all the
+/// same.
 fn stop_on_signal() -> anyhow::Result<Arc<AtomicBool>> {
     let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(EXIT_INTERRUPTED);
-        }
-        eprintln!(
+    signals::graceful(Graceful {
+        flag: Arc::clone(&stop),
+        notice: Some(
             "\nstopping: writing a checkpoint at the end of the steps under way \
-             (a second signal stops at once, without it)"
-        );
-    })
-    .context("cannot install the signal handler")?;
+             (a second signal stops at once, without it)",
+        ),
+        second_exits: true,
+    })?;
     Ok(stop)
 }
 

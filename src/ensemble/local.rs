@@ -12,6 +12,8 @@ use std::sync::Mutex;
 
 use anyhow::Context;
 
+use crate::child::{self, OnParentDeath};
+
 use super::{log_path, ReplicaCommand, TaskOutcome};
 
 /// Runs replicas 0..`replicas` with `cmd` (plus `--replica K`), at most `jobs` at once, each
@@ -58,21 +60,23 @@ pub fn run(
     Ok(outcomes)
 }
 
-/// Runs replica `k` and waits for it.
+/// Runs replica `k` and waits for it, on the calling thread (its worker, which outlives it).
 fn run_one(cmd: &ReplicaCommand, k: u64, out: &Path) -> anyhow::Result<TaskOutcome> {
     let log = log_path(out, k);
     let file = File::create(&log).with_context(|| format!("{}: cannot create", log.display()))?;
     let err = file
         .try_clone()
         .with_context(|| format!("{}: cannot open twice", log.display()))?;
-    let status = Command::new(&cmd.program)
-        .args(&cmd.args)
-        .args(["--replica", &k.to_string()])
-        .stdin(Stdio::null())
-        .stdout(file)
-        .stderr(err)
-        .status()
-        .with_context(|| format!("cannot start {}", cmd.program.display()))?;
+    let status = child::status(
+        Command::new(&cmd.program)
+            .args(&cmd.args)
+            .args(["--replica", &k.to_string()])
+            .stdin(Stdio::null())
+            .stdout(file)
+            .stderr(err),
+        OnParentDeath::Kill,
+    )
+    .with_context(|| format!("cannot start {}", cmd.program.display()))?;
     let exit = match status.code() {
         Some(code) => Ok(code),
         None => Err(signal_of(&status)),

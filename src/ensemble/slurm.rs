@@ -8,9 +8,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context};
+
+use crate::child::{self, OnParentDeath};
 
 use super::{log_path, replica_dir, ReplicaCommand, TaskOutcome};
 
@@ -82,12 +84,14 @@ pub fn run(
 ) -> anyhow::Result<(String, Vec<TaskOutcome>)> {
     let path = script_path(out, name);
     crate::io::atomic::write(&path, script(cmd, replicas, out, name).as_bytes())?;
-    let submitted = Command::new("sbatch")
-        .arg("--parsable")
-        .args(&o.sbatch_args)
-        .arg(&path)
-        .output()
-        .context("cannot run sbatch (is Slurm's client installed? else use --engine local)")?;
+    let submitted = child::output(
+        Command::new("sbatch")
+            .arg("--parsable")
+            .args(&o.sbatch_args)
+            .arg(&path),
+        OnParentDeath::Kill,
+    )
+    .context("cannot run sbatch (is Slurm's client installed? else use --engine local)")?;
     if !submitted.status.success() {
         bail!(
             "sbatch {} refused the job ({}): {}",
@@ -122,13 +126,13 @@ pub fn run(
 }
 
 /// Polls `squeue` until the job has no task left pending or running; prints the counts when
-/// they change. A stop request cancels the job.
+/// they change. A stop request cancels the job (between two polls, within 0.1 s).
 fn wait(job: &str, o: &Options) -> anyhow::Result<()> {
     let mut last = String::new();
     let mut failures = 0;
     loop {
-        if o.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed)) {
-            let cancelled = Command::new("scancel").arg(job).status();
+        if stop_requested(o) {
+            let cancelled = child::status(Command::new("scancel").arg(job), OnParentDeath::Kill);
             bail!(
                 "stopped waiting for Slurm job {job}; {}",
                 match cancelled {
@@ -137,10 +141,11 @@ fn wait(job: &str, o: &Options) -> anyhow::Result<()> {
                 }
             );
         }
-        let q = Command::new("squeue")
-            .args(["-h", "-r", "-j", job, "-o", "%T"])
-            .output()
-            .context("cannot run squeue")?;
+        let q = child::output(
+            Command::new("squeue").args(["-h", "-r", "-j", job, "-o", "%T"]),
+            OnParentDeath::Kill,
+        )
+        .context("cannot run squeue")?;
         let stderr = String::from_utf8_lossy(&q.stderr);
         if !q.status.success() {
             // a job that ended long ago is no longer known to squeue
@@ -182,7 +187,24 @@ fn wait(job: &str, o: &Options) -> anyhow::Result<()> {
                 last = now;
             }
         }
-        std::thread::sleep(o.poll);
+        pause(o);
+    }
+}
+
+/// Whether a stop was requested.
+fn stop_requested(o: &Options) -> bool {
+    o.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// Sleeps for the time between two polls, or until a stop is requested (within 0.1 s).
+fn pause(o: &Options) {
+    let end = Instant::now() + o.poll;
+    loop {
+        let now = Instant::now();
+        if now >= end || stop_requested(o) {
+            return;
+        }
+        std::thread::sleep((end - now).min(Duration::from_millis(100)));
     }
 }
 
@@ -197,12 +219,13 @@ fn exit_code(out: &Path, job: &str, k: u64) -> Result<i32, String> {
             .map_err(|_| format!("{}: not an exit code: {:?}", path.display(), text.trim()));
     }
     let task = format!("{job}_{k}");
-    let shown = Command::new("scontrol")
-        .args(["-o", "show", "job", &task])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8_lossy(&o.stdout).into_owned());
+    let shown = child::output(
+        Command::new("scontrol").args(["-o", "show", "job", &task]),
+        OnParentDeath::Kill,
+    )
+    .ok()
+    .filter(|o| o.status.success())
+    .map(|o| String::from_utf8_lossy(&o.stdout).into_owned());
     let field = |text: &str, key: &str| {
         text.split_whitespace()
             .find_map(|w| w.strip_prefix(key))
@@ -267,6 +290,28 @@ mod tests {
             "{s}"
         );
         assert!(s.ends_with("exit \"$status\"\n"), "{s}");
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_pause_between_two_polls() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let o = Options {
+            sbatch_args: Vec::new(),
+            poll: Duration::from_secs(600),
+            stop: Some(Arc::clone(&stop)),
+        };
+        let started = Instant::now();
+        std::thread::scope(|s| {
+            s.spawn(|| pause(&o));
+            std::thread::sleep(Duration::from_millis(50));
+            stop.store(true, Ordering::Relaxed);
+        });
+        // within the 0.1 s slice, not after the 600 s poll (a loaded machine allowing)
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "{:?}",
+            started.elapsed()
+        );
     }
 
     #[test]

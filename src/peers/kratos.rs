@@ -21,6 +21,7 @@ use anyhow::{bail, ensure, Context};
 use super::lammps_family::dump;
 use super::{Frame, Peer};
 use crate::case::{Case, Tangential};
+use crate::child::{self, OnParentDeath};
 use crate::io::atomic;
 use crate::state::{Contact, Motion, Snapshot};
 use crate::Vec3;
@@ -193,11 +194,11 @@ impl Peer for Kratos {
     /// `pip show` of [`PACKAGES`] in [`python`].
     fn version(&self) -> anyhow::Result<String> {
         let py = python();
-        let out = Command::new(&py)
-            .args(["-m", "pip", "show"])
-            .args(PACKAGES)
-            .output()
-            .map_err(|e| not_installed(&py, &format!("cannot start it: {e}")))?;
+        let out = child::output(
+            Command::new(&py).args(["-m", "pip", "show"]).args(PACKAGES),
+            OnParentDeath::Kill,
+        )
+        .map_err(|e| not_installed(&py, &format!("cannot start it: {e}")))?;
         let text = String::from_utf8_lossy(&out.stdout);
         let mut found = Vec::new();
         let mut name = None;
@@ -290,15 +291,17 @@ impl Peer for Kratos {
         let log =
             std::fs::File::create(&log_path).with_context(|| log_path.display().to_string())?;
         let py = python();
-        let status = Command::new(&py)
-            .arg(DRIVER_NAME)
-            .current_dir(dir)
-            .env("OMP_NUM_THREADS", np.to_string())
-            .stdin(Stdio::null())
-            .stdout(log.try_clone()?)
-            .stderr(log)
-            .status()
-            .map_err(|e| not_installed(&py, &format!("cannot start it: {e}")))?;
+        let status = child::status(
+            Command::new(&py)
+                .arg(DRIVER_NAME)
+                .current_dir(dir)
+                .env("OMP_NUM_THREADS", np.to_string())
+                .stdin(Stdio::null())
+                .stdout(log.try_clone()?)
+                .stderr(log),
+            OnParentDeath::Kill,
+        )
+        .map_err(|e| not_installed(&py, &format!("cannot start it: {e}")))?;
         let text =
             std::fs::read_to_string(&log_path).with_context(|| log_path.display().to_string())?;
         if text.contains("No module named 'KratosMultiphysics") {

@@ -22,6 +22,7 @@ pub mod dump;
 use super::inrun::WALLS_FILE;
 use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
+use crate::child::{self, OnParentDeath};
 use crate::io::atomic;
 use crate::state::Motion;
 use crate::state::{Contact, Snapshot};
@@ -261,13 +262,16 @@ fn run(binary: &str, package: &str, np: usize, dir: &Path, input: &str) -> anyho
         .with_context(|| dir.display().to_string())?;
     let script = dir.join(format!("in.{binary}"));
     std::fs::write(&script, input).with_context(|| script.display().to_string())?;
-    let out = Command::new("mpirun")
-        .args(mpirun_args(binary, np, &script.display().to_string()))
-        .current_dir(dir)
-        .output()
-        .with_context(|| {
-            format!("cannot start mpirun {binary} (install: apt-get install -y {package})")
-        })?;
+    // SIGTERM when verdem dies: mpirun then stops its ranks, each in a process group of its own
+    let out = child::output(
+        Command::new("mpirun")
+            .args(mpirun_args(binary, np, &script.display().to_string()))
+            .current_dir(dir),
+        OnParentDeath::Terminate,
+    )
+    .with_context(|| {
+        format!("cannot start mpirun {binary} (install: apt-get install -y {package})")
+    })?;
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     if !out.status.success() {
@@ -288,10 +292,11 @@ fn run(binary: &str, package: &str, np: usize, dir: &Path, input: &str) -> anyho
 
 /// The version of the installed Debian package `package`, after its name.
 fn package_version(package: &str) -> anyhow::Result<String> {
-    let out = Command::new("dpkg-query")
-        .args(["-W", "-f=${Version}", package])
-        .output()
-        .context("cannot start dpkg-query")?;
+    let out = child::output(
+        Command::new("dpkg-query").args(["-W", "-f=${Version}", package]),
+        OnParentDeath::Kill,
+    )
+    .context("cannot start dpkg-query")?;
     ensure!(
         out.status.success(),
         "dpkg-query: {}",

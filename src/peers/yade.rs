@@ -31,6 +31,7 @@ use anyhow::{bail, ensure, Context};
 
 use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
 use crate::case::{Case, Tangential};
+use crate::child::{self, OnParentDeath};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
 use crate::Vec3;
@@ -121,10 +122,11 @@ fn script(p: &Params, what: &str) -> String {
 
 /// The version of the installed Debian package.
 fn package_version() -> anyhow::Result<String> {
-    let out = Command::new("dpkg-query")
-        .args(["-W", "-f=${Version}", "yade"])
-        .output()
-        .context("cannot start dpkg-query")?;
+    let out = child::output(
+        Command::new("dpkg-query").args(["-W", "-f=${Version}", "yade"]),
+        OnParentDeath::Kill,
+    )
+    .context("cannot start dpkg-query")?;
     ensure!(
         out.status.success(),
         "dpkg-query: {}",
@@ -374,12 +376,14 @@ impl Peer for Yade {
             .with_context(|| dir.display().to_string())?;
         let script = dir.join(SCRIPT);
         std::fs::write(&script, input).with_context(|| script.display().to_string())?;
-        let out = Command::new("yade")
-            .args(["-j", &np.to_string(), "-n", "-x", SCRIPT])
-            .env("OMP_WAIT_POLICY", "PASSIVE")
-            .current_dir(dir)
-            .output()
-            .context("cannot start yade (install: apt-get install -y yade)")?;
+        let out = child::output(
+            Command::new("yade")
+                .args(["-j", &np.to_string(), "-n", "-x", SCRIPT])
+                .env("OMP_WAIT_POLICY", "PASSIVE")
+                .current_dir(dir),
+            OnParentDeath::Kill,
+        )
+        .context("cannot start yade (install: apt-get install -y yade)")?;
         let text = String::from_utf8_lossy(&out.stdout).to_string()
             + &String::from_utf8_lossy(&out.stderr);
         let seconds = text.lines().find_map(|l| {

@@ -5,7 +5,6 @@
 //! verdem's law; [`External`] runs another program through files, with the interface of
 //! `verdem kinematics` (`docs/code-interface.md`).
 
-use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -14,6 +13,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 
 use crate::case::Case;
+use crate::child::{self, OnParentDeath};
 use crate::io::{self, atomic};
 use crate::kinematics::{self, ForceRow, Increment, MotionRow};
 
@@ -154,21 +154,23 @@ impl External {
         let create = |p: &Path| {
             std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))
         };
-        // its own process group, so that a run past its time is stopped with its children
-        let mut child = Command::new("sh")
-            .arg("-c")
-            .arg(format!("{} \"$@\"", self.cmd))
-            .arg("sh")
-            .arg(case_file)
-            .arg(motion_file)
-            .arg("--out")
-            .arg(forces_file)
-            .stdin(std::process::Stdio::null())
-            .stdout(create(&stdout_file)?)
-            .stderr(create(&stderr_file)?)
-            .process_group(0)
-            .spawn()
-            .context("cannot start `sh -c` to run the program")?;
+        // in its own process group, so that a run past its time is stopped with its children;
+        // waited for on this thread
+        let mut child = child::spawn(
+            Command::new("sh")
+                .arg("-c")
+                .arg(format!("{} \"$@\"", self.cmd))
+                .arg("sh")
+                .arg(case_file)
+                .arg(motion_file)
+                .arg("--out")
+                .arg(forces_file)
+                .stdin(std::process::Stdio::null())
+                .stdout(create(&stdout_file)?)
+                .stderr(create(&stderr_file)?),
+            OnParentDeath::Kill,
+        )
+        .context("cannot start `sh -c` to run the program")?;
         let started = Instant::now();
         let status = loop {
             if let Some(status) = child.try_wait().context("cannot wait for the program")? {
@@ -176,9 +178,7 @@ impl External {
             }
             if started.elapsed() > self.timeout {
                 // SIGKILL to the group: the shell and whatever it started
-                let _ = Command::new("kill")
-                    .args(["-KILL", "--", &format!("-{}", child.id())])
-                    .status();
+                child.kill_group();
                 let _ = child.wait();
                 anyhow::bail!(
                     "`{} {} {} --out {}` did not end within {} s and was stopped (its output: {})",
