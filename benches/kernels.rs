@@ -1,7 +1,8 @@
 //! Criterion benchmarks: the pair-force kernel (with MercuryDPM's friction, and the frictionless
 //! law a `mu = 0` case runs), the pair-list rebuild, one full time step of
 //! MercuryDPM's developed shear state (1 and 2 threads), the team's barrier (the fixed cost of
-//! synchronising two threads, paid twice a step), and the coarse-graining of one save.
+//! synchronising two threads, paid twice a step), the coarse-graining of one save, and the
+//! writer's scan of a save's text for non-finite numbers against making that text.
 //! Reads `data/states/mercury_t143.85.data`. Run: `cargo bench`.
 
 use std::hint::black_box;
@@ -138,10 +139,22 @@ fn coarse_grain(c: &mut Criterion) {
     });
 }
 
+fn save_text(c: &mut Criterion) {
+    let (_, e) = developed(1);
+    let snap = e.snapshot();
+    let text = verdem::io::mercury::data_text(&snap);
+    c.bench_function("a save's .data text made", |b| {
+        b.iter(|| black_box(verdem::io::mercury::data_text(&snap)))
+    });
+    c.bench_function("a save's .data text scanned for non-finite numbers", |b| {
+        b.iter(|| black_box(verdem::io::atomic::non_finite(text.as_bytes())))
+    });
+}
+
 criterion_group! {
     name = benches;
     // no HTML plots: they would need a font registered with plotters
     config = Criterion::default().without_plots();
-    targets = pair_kernel, rebuild, step, barrier, coarse_grain
+    targets = pair_kernel, rebuild, step, barrier, coarse_grain, save_text
 }
 criterion_main!(benches);
