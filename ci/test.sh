@@ -30,7 +30,8 @@ export VERDEM_SLURM=1
 
 echo "== Python packages (virtual environment target/venv)"
 # Kratos DEM (a peer) and meshio (an independent VTK reader), pinned in ci/requirements.txt.
-# The tests find this Python through VERDEM_PYTHON.
+# The tests find this Python through VERDEM_PYTHON; verdem also finds it unset (docs/cli.md,
+# "verdem peers").
 stamp=target/venv/requirements.sha256
 want=$(sha256sum ci/requirements.txt | cut -d' ' -f1)
 if [ ! -x target/venv/bin/python ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then

@@ -16,6 +16,7 @@ pub mod io;
 pub mod kinematics;
 pub mod neighbor;
 pub mod peers;
+pub mod python;
 pub mod run;
 pub mod scene;
 pub mod stability;

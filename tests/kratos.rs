@@ -1,7 +1,7 @@
-//! Kratos DEM as a peer (PyPI KratosMultiphysics and KratosDEMApplication 10.4.4 in the Python
-//! named by VERDEM_PYTHON, which ci/test.sh makes): the binary collisions against the closed
-//! forms, a short cross-run on the quick case, the threads of a timing run and the error of a
-//! Python without Kratos.
+//! Kratos DEM as a peer (PyPI KratosMultiphysics and KratosDEMApplication 10.4.4 in verdem's
+//! Python: VERDEM_PYTHON, else the virtual environment target/venv that ci/test.sh makes): the
+//! binary collisions against the closed forms, a short cross-run on the quick case, the threads
+//! of a timing run and the error of a Python without Kratos.
 
 mod common;
 

@@ -3,6 +3,9 @@
 
 mod common;
 
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+
 use verdem::engine::Overrides;
 use verdem::peers::{self, lammps_family::data_file, Peer};
 
@@ -60,6 +63,190 @@ fn the_command_line_knows_the_peers_of_the_registry() {
             "{args:?}: {err}"
         );
     }
+}
+
+/// A fake Python at `path`: a shell script answering `-m pip show` as pip does, with `tag` as
+/// the version of both Kratos packages.
+fn fake_python(path: &Path, tag: &str) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(
+        path,
+        format!(
+            "#!/bin/sh\nprintf 'Name: KratosMultiphysics\\nVersion: {tag}\\n\
+             Name: KratosDEMApplication\\nVersion: {tag}\\n'\n"
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+/// A copy of the verdem binary at `dir/target/ci/verdem` (a clone's build), returned.
+fn copied_verdem(dir: &Path) -> PathBuf {
+    let exe = dir.join("target/ci/verdem");
+    std::fs::create_dir_all(exe.parent().unwrap()).unwrap();
+    std::fs::copy(env!("CARGO_BIN_EXE_verdem"), &exe).unwrap();
+    exe
+}
+
+/// `exe peers NAMES` run in `cwd` with `VERDEM_PYTHON` `python` (unset when `None`) and, when
+/// given, `PATH`; its output, once it has exited successfully.
+fn peers_in(
+    exe: &Path,
+    names: &str,
+    cwd: &Path,
+    python: Option<&str>,
+    path: Option<&str>,
+) -> String {
+    let mut c = std::process::Command::new(exe);
+    c.args(["peers", names]).current_dir(cwd);
+    match python {
+        Some(p) => c.env("VERDEM_PYTHON", p),
+        None => c.env_remove("VERDEM_PYTHON"),
+    };
+    if let Some(path) = path {
+        c.env("PATH", path);
+    }
+    let out = c.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Kratos' Python is `VERDEM_PYTHON` when set (not empty), else `target/venv/bin/python` under
+/// the current directory, else the one in the running binary's target folder, else `python3`;
+/// `verdem peers kratos` runs it (the fake's versions) and says which it is and why.
+#[test]
+fn the_python_is_verdem_python_else_a_virtual_environment_else_python3() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (clone, built, bare, elsewhere) = (
+        tmp.path().join("clone"),
+        tmp.path().join("built"),
+        tmp.path().join("bare"),
+        tmp.path().join("elsewhere"),
+    );
+    std::fs::create_dir_all(&elsewhere).unwrap();
+    let venv = clone.join("target/venv/bin/python");
+    fake_python(&venv, "in-current-dir");
+    let named = tmp.path().join("named/python");
+    fake_python(&named, "named");
+    let test_binary = Path::new(env!("CARGO_BIN_EXE_verdem"));
+    let installed = |tag: &str, python: &Path, why: &str| {
+        format!(
+            "\tKratosMultiphysics {tag}, KratosDEMApplication {tag} in {} ({why})\n",
+            python.display()
+        )
+    };
+    let here = "target/venv/bin/python in the current directory, the virtual environment \
+                ci/test.sh makes; VERDEM_PYTHON unset";
+    for python in [None, Some("")] {
+        let line = peers_in(test_binary, "kratos", &clone, python, None);
+        assert!(
+            line.ends_with(&installed("in-current-dir", &venv, here)),
+            "{python:?}: {line}"
+        );
+        assert!(
+            line.contains(&format!(
+                "\tOMP_NUM_THREADS=1 {} verdem_kratos.py",
+                venv.display()
+            )),
+            "{line}"
+        );
+    }
+    let line = peers_in(test_binary, "kratos", &clone, named.to_str(), None);
+    assert!(
+        line.ends_with(&installed("named", &named, "VERDEM_PYTHON")),
+        "{line}"
+    );
+
+    let exe = copied_verdem(&built);
+    let beside = built.join("target/venv/bin/python");
+    fake_python(&beside, "beside-binary");
+    let line = peers_in(&exe, "kratos", &elsewhere, None, None);
+    assert!(
+        line.ends_with(&installed(
+            "beside-binary",
+            &beside,
+            "venv/bin/python in the running verdem's target folder, the virtual environment \
+             ci/test.sh makes; VERDEM_PYTHON unset and no target/venv in the current directory"
+        )),
+        "{line}"
+    );
+    let line = peers_in(&exe, "kratos", &clone, None, None);
+    assert!(
+        line.ends_with(&installed("in-current-dir", &venv, here)),
+        "{line}"
+    );
+
+    let exe = copied_verdem(&bare);
+    let line = peers_in(&exe, "kratos", &elsewhere, None, None);
+    assert!(
+        line.contains("\tOMP_NUM_THREADS=1 python3 verdem_kratos.py")
+            && line.contains(
+                "python3 (VERDEM_PYTHON unset, no target/venv/bin/python in the current \
+                 directory nor in the running verdem's target folder)"
+            ),
+        "{line}"
+    );
+}
+
+/// With nothing on PATH and no virtual environment every peer is listed as not installed, with
+/// the exact command that installs what it lacks.
+#[test]
+fn a_missing_peer_is_listed_with_the_command_that_installs_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exe = copied_verdem(&tmp.path().join("bare"));
+    let text = peers_in(
+        &exe,
+        &peers::names(),
+        tmp.path(),
+        None,
+        Some("/nonexistent"),
+    );
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), peers::all().len(), "{text}");
+    for (line, peer) in lines.iter().zip(peers::all()) {
+        let fields: Vec<&str> = line.split('\t').collect();
+        assert_eq!(fields[0], peer.name(), "{text}");
+        assert!(
+            fields[4].starts_with("not installed: ") && fields[4].contains("; install it with `"),
+            "{line}"
+        );
+    }
+    let status = |name: &str| {
+        let line = lines
+            .iter()
+            .find(|l| l.starts_with(&format!("{name}\t")))
+            .unwrap();
+        line.rsplit('\t').next().unwrap().to_string()
+    };
+    for (name, binary) in [("lammps", "lmp"), ("liggghts", "liggghts")] {
+        assert_eq!(
+            status(name),
+            format!(
+                "not installed: {binary} and mpirun are not on PATH; install it with \
+                 `apt-get install -y {name} openmpi-bin`"
+            )
+        );
+    }
+    assert_eq!(
+        status("yade"),
+        "not installed: yade is not on PATH; install it with `apt-get install -y yade`"
+    );
+    let kratos = status("kratos");
+    assert!(
+        kratos.starts_with(
+            "not installed: Kratos DEM is not installed for python3 (VERDEM_PYTHON unset, no \
+             target/venv/bin/python in the current directory nor in the running verdem's target \
+             folder): cannot start it: "
+        ) && kratos.ends_with(
+            "; install it with `python3 -m venv target/venv && target/venv/bin/python -m pip \
+             install -r ci/requirements.txt`"
+        ),
+        "{kratos}"
+    );
 }
 
 #[test]

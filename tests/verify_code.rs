@@ -17,14 +17,14 @@ fn cases() -> std::path::PathBuf {
     common::root().join("cases/verify")
 }
 
-fn python() -> String {
-    std::env::var("VERDEM_PYTHON").unwrap_or_else(|_| "python3".into())
-}
-
 /// The command running tests/code/`script` with `args`.
 fn script(script: &str, args: &str) -> String {
     let path = common::root().join("tests/code").join(script);
-    format!("{} {} {args}", python(), path.display())
+    format!(
+        "{} {} {args}",
+        verdem::python::python().program.display(),
+        path.display()
+    )
 }
 
 /// Every prescribed-motion row of `driver`, gated as `claim` claims.

@@ -1,8 +1,8 @@
 //! ParaView output read back by an independent reader (Python's meshio, in the virtual
-//! environment `ci/test.sh` makes; its Python is VERDEM_PYTHON) and compared with the MercuryCG
-//! save it shows: positions, radii, velocities and spins bit for bit, the wall spheres, and one
-//! line per contact of the `.fstat` carrying its normal and tangential force. A run's `.pvd` is
-//! also opened by ParaView's own reader.
+//! environment `ci/test.sh` makes; its Python is verdem's, `verdem::python::python`) and
+//! compared with the MercuryCG save it shows: positions, radii, velocities and spins bit for
+//! bit, the wall spheres, and one line per contact of the `.fstat` carrying its normal and
+//! tangential force. A run's `.pvd` is also opened by ParaView's own reader.
 
 mod common;
 
@@ -11,18 +11,6 @@ use std::path::Path;
 use std::process::Command;
 
 use verdem::io::mercury::{read_data, read_fstat, save_path};
-
-/// The Python with meshio.
-fn python() -> String {
-    std::env::var("VERDEM_PYTHON").unwrap_or_else(|_| {
-        panic!(
-            "VERDEM_PYTHON is not set: these tests read the VTK files with meshio. Run \
-             `bash ci/test.sh` (it makes the virtual environment target/venv from \
-             ci/requirements.txt and sets it), or set VERDEM_PYTHON=$PWD/target/venv/bin/python \
-             once that environment exists"
-        )
-    })
-}
 
 /// Prints each array of a `.vtu` as `NAME v v v …` (shortest round-trip decimals), the lines'
 /// point pairs, the field TimeValue.
@@ -57,14 +45,16 @@ for d in ET.parse(sys.argv[1]).getroot().iter("DataSet"):
 "#;
 
 fn run_python(script: &str, file: &Path) -> String {
-    let o = Command::new(python())
+    let python = verdem::python::python();
+    let o = Command::new(&python.program)
         .args(["-c", script])
         .arg(file)
         .output()
-        .expect("VERDEM_PYTHON runs");
+        .unwrap_or_else(|e| panic!("{python}: {e}"));
     assert!(
         o.status.success(),
-        "{}: {}",
+        "{}: {python}: {} (these tests read the VTK files with meshio: `bash ci/test.sh` makes \
+         the virtual environment target/venv from ci/requirements.txt)",
         file.display(),
         String::from_utf8_lossy(&o.stderr)
     );

@@ -4,8 +4,9 @@
 //! them, runs it and writes its saves in the LAMMPS dump layout
 //! ([`crate::peers::lammps_family::dump`]).
 //!
-//! The Python is `$VERDEM_PYTHON`, else `python3`; Kratos DEM is installed into it with
-//! [`PIP_INSTALL`]. The mapping of the benchmark's law onto Kratos' (with the Kratos sources
+//! The Python is [`crate::python::python`]'s (`$VERDEM_PYTHON`, else the virtual environment
+//! `target/venv` that `ci/test.sh` makes, else `python3`); Kratos DEM is installed into it with
+//! [`install_command`]. The mapping of the benchmark's law onto Kratos' (with the Kratos sources
 //! of each parameter) is in the driver's header and in `docs/verification.md` ("Kratos DEM as a peer"): the normal law is the
 //! benchmark's with the force clipped at zero; the absolute normal damping is exact for
 //! spheres of one mass; the tangential dashpot is γn·√(kt/kn) instead of γt and the Coulomb
@@ -19,10 +20,11 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, ensure, Context};
 
 use super::lammps_family::dump;
-use super::{Frame, Peer};
+use super::{Frame, Installed, Peer};
 use crate::case::{Case, Tangential};
 use crate::child::{self, OnParentDeath};
 use crate::io::atomic;
+use crate::python::{python, Python, Source, VENV};
 use crate::state::{Contact, Motion, Snapshot};
 use crate::Vec3;
 
@@ -44,7 +46,7 @@ const LOG: &str = "kratos.log";
 /// The packages and versions verdem's driver is written for.
 pub const PACKAGES: [&str; 2] = ["KratosMultiphysics", "KratosDEMApplication"];
 
-/// How Kratos DEM is installed into the Python verdem runs (`$VERDEM_PYTHON`).
+/// How Kratos DEM is installed into a given Python: the arguments after the program.
 pub const PIP_INSTALL: &str =
     "-m pip install KratosMultiphysics==10.4.4 KratosDEMApplication==10.4.4";
 
@@ -54,16 +56,41 @@ const LOOP_LINE: &str = "verdem-kratos loop seconds: ";
 /// The file in which the driver counts the steps a collision's pair overlaps.
 const CONTACT_STEPS: &str = "contact_steps.txt";
 
-/// The Python that runs Kratos: `$VERDEM_PYTHON`, else `python3`.
-pub fn python() -> String {
-    std::env::var("VERDEM_PYTHON").unwrap_or_else(|_| "python3".to_string())
+/// The shell command that installs Kratos DEM for `python`: [`PIP_INSTALL`] into a Python that
+/// was named (`$VERDEM_PYTHON`) or found (a virtual environment); for the default `python3`
+/// (whose system-wide pip Debian refuses), the virtual environment `ci/test.sh` makes, from
+/// the clone's root, where verdem then finds it.
+pub fn install_command(python: &Python) -> String {
+    match python.source {
+        Source::Default => format!(
+            "python3 -m venv {VENV} && {VENV}/bin/python -m pip install -r ci/requirements.txt"
+        ),
+        Source::Env | Source::CurrentDir | Source::BesideBinary => {
+            format!("{} {PIP_INSTALL}", python.program.display())
+        }
+    }
 }
 
-/// The error of a Python without Kratos DEM: what to install and how.
-fn not_installed(python: &str, why: &str) -> anyhow::Error {
+/// What is missing when `python` lacks Kratos DEM: which Python (and why that one) and what
+/// failed (`why`).
+fn lacks(python: &Python, why: &str) -> String {
+    format!("Kratos DEM is not installed for {python}: {why}")
+}
+
+/// A Python without Kratos DEM, for `verdem peers` ([`lacks`], [`install_command`]).
+fn missing(python: &Python, why: &str) -> Installed {
+    Installed::No {
+        missing: lacks(python, why),
+        install: install_command(python),
+    }
+}
+
+/// The error of a run whose Python lacks Kratos DEM: [`lacks`] and how to install it.
+fn not_installed(python: &Python, why: &str) -> anyhow::Error {
     anyhow::anyhow!(
-        "Kratos DEM is not installed for {python} ({why}); install it with `{python} {PIP_INSTALL}` \
-         (or set VERDEM_PYTHON to a Python that has it, e.g. target/venv/bin/python made by ci/test.sh)"
+        "{}; install it with `{}` (or set VERDEM_PYTHON to a Python that has it)",
+        lacks(python, why),
+        install_command(python)
     )
 }
 
@@ -191,14 +218,19 @@ impl Peer for Kratos {
         "kratos"
     }
 
-    /// `pip show` of [`PACKAGES`] in [`python`].
-    fn version(&self) -> anyhow::Result<String> {
+    /// `pip show` of [`PACKAGES`] in [`python`], after which the Python is named with why it
+    /// is that one.
+    fn installed(&self) -> Installed {
         let py = python();
-        let out = child::output(
-            Command::new(&py).args(["-m", "pip", "show"]).args(PACKAGES),
+        let out = match child::output(
+            Command::new(&py.program)
+                .args(["-m", "pip", "show"])
+                .args(PACKAGES),
             OnParentDeath::Kill,
-        )
-        .map_err(|e| not_installed(&py, &format!("cannot start it: {e}")))?;
+        ) {
+            Ok(out) => out,
+            Err(e) => return missing(&py, &format!("cannot start it: {e}")),
+        };
         let text = String::from_utf8_lossy(&out.stdout);
         let mut found = Vec::new();
         let mut name = None;
@@ -210,15 +242,15 @@ impl Peer for Kratos {
             }
         }
         if !out.status.success() || found.len() != PACKAGES.len() {
-            return Err(not_installed(
+            return missing(
                 &py,
                 String::from_utf8_lossy(&out.stderr)
                     .lines()
                     .next()
                     .unwrap_or("pip show found neither package"),
-            ));
+            );
         }
-        Ok(found.join(", "))
+        Installed::Yes(format!("{} in {py}", found.join(", ")))
     }
 
     /// No verdem convention integrates Kratos' tangential law (its dashpot is γn·√(kt/kn),
@@ -292,7 +324,7 @@ impl Peer for Kratos {
             std::fs::File::create(&log_path).with_context(|| log_path.display().to_string())?;
         let py = python();
         let status = child::status(
-            Command::new(&py)
+            Command::new(&py.program)
                 .arg(DRIVER_NAME)
                 .current_dir(dir)
                 .env("OMP_NUM_THREADS", np.to_string())
@@ -332,7 +364,7 @@ impl Peer for Kratos {
     fn command_line(&self, np: usize) -> String {
         format!(
             "OMP_NUM_THREADS={np} {} {DRIVER_NAME} (reads {SETTINGS}) > {LOG} 2>&1",
-            python()
+            python().program.display()
         )
     }
 

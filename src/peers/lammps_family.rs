@@ -20,7 +20,7 @@ use anyhow::{bail, ensure, Context};
 pub mod dump;
 
 use super::inrun::WALLS_FILE;
-use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
+use super::{placed_contacts, wall_speeds, Frame, Installed, Naming, Peer, Program, MPIRUN};
 use crate::case::{Case, Tangential};
 use crate::child::{self, OnParentDeath};
 use crate::io::atomic;
@@ -270,7 +270,10 @@ fn run(binary: &str, package: &str, np: usize, dir: &Path, input: &str) -> anyho
         OnParentDeath::Terminate,
     )
     .with_context(|| {
-        format!("cannot start mpirun {binary} (install: apt-get install -y {package})")
+        format!(
+            "cannot start mpirun {binary} (install: apt-get install -y {package} {})",
+            MPIRUN.package
+        )
     })?;
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
@@ -290,24 +293,6 @@ fn run(binary: &str, package: &str, np: usize, dir: &Path, input: &str) -> anyho
         .with_context(|| format!("{binary}: no 'Loop time' line in its output"))
 }
 
-/// The version of the installed Debian package `package`, after its name.
-fn package_version(package: &str) -> anyhow::Result<String> {
-    let out = child::output(
-        Command::new("dpkg-query").args(["-W", "-f=${Version}", package]),
-        OnParentDeath::Kill,
-    )
-    .context("cannot start dpkg-query")?;
-    ensure!(
-        out.status.success(),
-        "dpkg-query: {}",
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    Ok(format!(
-        "{package} {}",
-        String::from_utf8_lossy(&out.stdout)
-    ))
-}
-
 impl<D: Dialect> Peer for D {
     fn name(&self) -> &'static str {
         D::NAME
@@ -317,8 +302,16 @@ impl<D: Dialect> Peer for D {
         D::BINARY
     }
 
-    fn version(&self) -> anyhow::Result<String> {
-        package_version(D::NAME)
+    /// Its program from its Debian package (named as the peer) and [`MPIRUN`], which starts
+    /// it.
+    fn installed(&self) -> Installed {
+        super::debian(&[
+            Program {
+                name: D::BINARY,
+                package: D::NAME,
+            },
+            MPIRUN,
+        ])
     }
 
     fn convention(&self) -> Tangential {

@@ -8,9 +8,11 @@
 //! [`lammps_family`]. Names are parsed here once ([`by_name`], [`parse_list`]).
 
 use std::fmt;
-use std::path::Path;
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
-use anyhow::bail;
+use anyhow::{bail, Context};
 
 pub mod collision;
 pub mod cross;
@@ -23,6 +25,7 @@ pub mod motion;
 pub mod yade;
 
 use crate::case::{Case, Scene, Tangential};
+use crate::child::{self, OnParentDeath};
 use crate::state::{Contact, PairForce, Snapshot};
 use crate::Vec3;
 
@@ -43,8 +46,9 @@ pub trait Peer: Sync {
     /// The installed program it runs (`lmp`); also the folder of its runs in an output folder.
     fn binary(&self) -> &'static str;
 
-    /// The installed version, with the package it comes from (`lammps 20220106.git7586adbb6a+ds1-2+b2`).
-    fn version(&self) -> anyhow::Result<String>;
+    /// Whether it is installed: its version, or what is missing and the command that installs
+    /// it.
+    fn installed(&self) -> Installed;
 
     /// The verdem tangential convention that integrates the same equations as its contact law.
     fn convention(&self) -> Tangential;
@@ -176,6 +180,108 @@ impl PartialEq for dyn Peer + '_ {
     }
 }
 
+/// Whether a peer is installed ([`Peer::installed`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Installed {
+    /// Installed: its version, after the package it comes from
+    /// (`lammps 20220106.git7586adbb6a+ds1-2+b2, openmpi-bin 4.1.4-3`).
+    Yes(String),
+    /// Not installed: what is missing, and the exact shell command that installs it.
+    No { missing: String, install: String },
+}
+
+/// The version, or `not installed: MISSING; install it with `COMMAND``.
+impl fmt::Display for Installed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Installed::Yes(version) => f.write_str(version),
+            Installed::No { missing, install } => {
+                write!(f, "not installed: {missing}; install it with `{install}`")
+            }
+        }
+    }
+}
+
+/// A program a peer starts by name, and the Debian package it comes from (as `ci/test.sh`
+/// installs it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Program {
+    pub name: &'static str,
+    pub package: &'static str,
+}
+
+/// OpenMPI's `mpirun`, which starts the LAMMPS family.
+pub const MPIRUN: Program = Program {
+    name: "mpirun",
+    package: "openmpi-bin",
+};
+
+/// The first executable file `name` in the directories of `$PATH`: the program a child
+/// started by that name runs; `None` when there is none.
+fn on_path(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|p| {
+            std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+        })
+}
+
+/// Whether all of `programs` are installed: when each is on PATH ([`on_path`]), the versions of
+/// their Debian packages (`PACKAGE VERSION`, comma-separated; a program that no installed
+/// package holds is named with its path instead); else the ones missing, and the
+/// `apt-get install -y` of their packages.
+pub fn debian(programs: &[Program]) -> Installed {
+    let found: Vec<Option<PathBuf>> = programs.iter().map(|p| on_path(p.name)).collect();
+    let missing: Vec<&Program> = programs
+        .iter()
+        .zip(&found)
+        .filter(|(_, f)| f.is_none())
+        .map(|(p, _)| p)
+        .collect();
+    if !missing.is_empty() {
+        let names: Vec<&str> = missing.iter().map(|p| p.name).collect();
+        let packages: Vec<&str> = missing.iter().map(|p| p.package).collect();
+        return Installed::No {
+            missing: format!(
+                "{} {} not on PATH",
+                names.join(" and "),
+                if names.len() == 1 { "is" } else { "are" }
+            ),
+            install: format!("apt-get install -y {}", packages.join(" ")),
+        };
+    }
+    Installed::Yes(
+        programs
+            .iter()
+            .zip(found.into_iter().flatten())
+            .map(|(p, path)| {
+                package_version(p.package)
+                    .unwrap_or_else(|e| format!("{} at {} ({e:#})", p.name, path.display()))
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
+    )
+}
+
+/// The version of the installed Debian package `package`, after its name.
+fn package_version(package: &str) -> anyhow::Result<String> {
+    let out = child::output(
+        Command::new("dpkg-query").args(["-W", "-f=${Version}", package]),
+        OnParentDeath::Kill,
+    )
+    .context("cannot start dpkg-query")?;
+    anyhow::ensure!(
+        out.status.success(),
+        "dpkg-query: {}",
+        String::from_utf8_lossy(&out.stderr).trim()
+    );
+    Ok(format!(
+        "{package} {}",
+        String::from_utf8_lossy(&out.stdout)
+    ))
+}
+
 /// One save of a peer: particles in id order (id 1 first); lengths and times in the case's
 /// units.
 #[derive(Clone, Debug, PartialEq)]
@@ -256,20 +362,19 @@ pub fn parse_list(list: &str) -> anyhow::Result<Vec<&'static dyn Peer>> {
 }
 
 /// One line per peer of `peers`, tab-separated: name, binary, convention, the command line
-/// of a 1-process run, and the installed version (or `not installed: …`).
+/// of a 1-process run, and whether it is installed ([`Installed`]: its version, or
+/// `not installed: …; install it with `COMMAND``).
 pub fn listing(peers: &[&dyn Peer]) -> String {
     peers
         .iter()
         .map(|p| {
-            let version = p
-                .version()
-                .unwrap_or_else(|e| format!("not installed: {e:#}"));
             format!(
-                "{}\t{}\t{}\t{}\t{version}\n",
+                "{}\t{}\t{}\t{}\t{}\n",
                 p.name(),
                 p.binary(),
                 p.convention().name(),
-                p.command_line(1)
+                p.command_line(1),
+                p.installed()
             )
         })
         .collect()

@@ -29,7 +29,7 @@ use std::process::Command;
 
 use anyhow::{bail, ensure, Context};
 
-use super::{placed_contacts, wall_speeds, Frame, Naming, Peer};
+use super::{placed_contacts, wall_speeds, Frame, Installed, Naming, Peer, Program};
 use crate::case::{Case, Tangential};
 use crate::child::{self, OnParentDeath};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
@@ -120,21 +120,6 @@ fn script(p: &Params, what: &str) -> String {
     s
 }
 
-/// The version of the installed Debian package.
-fn package_version() -> anyhow::Result<String> {
-    let out = child::output(
-        Command::new("dpkg-query").args(["-W", "-f=${Version}", "yade"]),
-        OnParentDeath::Kill,
-    )
-    .context("cannot start dpkg-query")?;
-    ensure!(
-        out.status.success(),
-        "dpkg-query: {}",
-        String::from_utf8_lossy(&out.stderr).trim()
-    );
-    Ok(format!("yade {}", String::from_utf8_lossy(&out.stdout)))
-}
-
 /// The rows of a file the script wrote: `columns` numbers each after the `#` header.
 fn read_rows(path: &Path, columns: usize) -> Result<Vec<Vec<f64>>, FormatError> {
     let (file, text) = read_text(path)?;
@@ -180,8 +165,12 @@ impl Peer for Yade {
         "yade"
     }
 
-    fn version(&self) -> anyhow::Result<String> {
-        package_version()
+    /// `yade` from the Debian package `yade`.
+    fn installed(&self) -> Installed {
+        super::debian(&[Program {
+            name: "yade",
+            package: "yade",
+        }])
     }
 
     fn convention(&self) -> Tangential {
