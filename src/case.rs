@@ -285,9 +285,35 @@ pub struct SphereSpec {
 /// a person writes or a tool generates, far below this.
 pub const MAX_CASE_BYTES: u64 = 64 << 20;
 
+/// What a case is read for, which decides the checks it gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Purpose {
+    /// Integrated by verdem's scheme: every check, the time step's against the scheme's
+    /// stability limit included.
+    Run,
+    /// Its contact law driven through a prescribed motion, which integrates nothing: every
+    /// check but the time step's against the scheme ([`Case::validate_time_step`]).
+    PrescribedMotion,
+}
+
 impl Case {
     /// Reads and validates a case file.
     pub fn load(path: &Path) -> Result<Case, CaseError> {
+        Case::load_for(path, Purpose::Run)
+    }
+
+    /// Reads and validates a case file whose contact law is driven through a prescribed
+    /// motion (`verdem kinematics`, the prescribed-motion cases of `verdem verify`): as
+    /// [`Case::load`], but a time step beyond the scheme's stability limit is not refused nor
+    /// a coarse one warned about, since the motion's rows, not `run.dt`, set the steps the law
+    /// sees. The law's own parameters are checked as for a run (finite, `kn`, `density`,
+    /// `diameter`, radii > 0; `gamman`, `kt`, `gammat`, `mu` >= 0; a collision time, a mass
+    /// and an elastic energy a double holds); [`Case::warnings`] is empty.
+    pub fn load_for_prescribed_motion(path: &Path) -> Result<Case, CaseError> {
+        Case::load_for(path, Purpose::PrescribedMotion)
+    }
+
+    fn load_for(path: &Path, purpose: Purpose) -> Result<Case, CaseError> {
         use std::io::Read;
         let file = path.display().to_string();
         let whole = |msg: String| CaseError {
@@ -318,7 +344,7 @@ impl Case {
                 ),
             }
         })?;
-        let mut case = Case::parse(&text, &file)?;
+        let mut case = Case::parse_for(&text, &file, purpose)?;
         case.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         case.path = path.to_path_buf();
         Ok(case)
@@ -326,6 +352,16 @@ impl Case {
 
     /// Parses and validates case text; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Case, CaseError> {
+        Case::parse_for(text, file, Purpose::Run)
+    }
+
+    /// Parses and validates case text for a prescribed motion, with the checks of
+    /// [`Case::load_for_prescribed_motion`]; `file` names it in errors.
+    pub fn parse_for_prescribed_motion(text: &str, file: &str) -> Result<Case, CaseError> {
+        Case::parse_for(text, file, Purpose::PrescribedMotion)
+    }
+
+    fn parse_for(text: &str, file: &str, purpose: Purpose) -> Result<Case, CaseError> {
         let mut case: Case = toml::from_str(text).map_err(|e| {
             let mut line = e
                 .span()
@@ -383,7 +419,7 @@ impl Case {
         {
             return Err(at.error(&field, format!("a finite number expected, got {value}")));
         }
-        case.warnings = case.validate(&at)?;
+        case.warnings = case.validate(&at, purpose)?;
         Ok(case)
     }
 
@@ -393,8 +429,8 @@ impl Case {
         &self.warnings
     }
 
-    /// Checks what the schema cannot; returns the warnings.
-    fn validate(&self, at: &Locator<'_>) -> Result<Vec<String>, CaseError> {
+    /// Checks what the schema cannot, as `purpose` needs; returns the warnings.
+    fn validate(&self, at: &Locator<'_>, purpose: Purpose) -> Result<Vec<String>, CaseError> {
         let err = |table: &str, key: &str, msg: String| {
             if table.is_empty() {
                 at.error(key, msg)
@@ -501,7 +537,10 @@ impl Case {
             ));
         }
         self.validate_scene(at)?;
-        self.validate_time_step(at)
+        match purpose {
+            Purpose::Run => self.validate_time_step(at),
+            Purpose::PrescribedMotion => Ok(Vec::new()),
+        }
     }
 
     /// Refuses parameters whose derived quantities a double cannot hold: a sphere's mass, the
@@ -1273,6 +1312,42 @@ mod tests {
             e.to_string(),
             format!("bad.toml:{line}: contact.kn: must be > 0, got -3")
         );
+    }
+
+    /// A prescribed motion integrates nothing: the time step's checks against the scheme are
+    /// a run's only, the law's are every reader's.
+    #[test]
+    fn a_prescribed_motion_gets_the_laws_checks_and_not_the_time_steps() {
+        let dt = |v: &str| CASE.replace("dt = 7.192545031528827e-05", &format!("dt = {v}"));
+        // tc/5, then tc/1, beyond the limit tc/1.62
+        let coarse = dt("7.192545031528827e-04");
+        assert_eq!(Case::parse(&coarse, "c.toml").unwrap().warnings().len(), 1);
+        let read = Case::parse_for_prescribed_motion(&coarse, "c.toml").unwrap();
+        assert!(read.warnings().is_empty());
+        let beyond = dt("3.6e-3");
+        let e = Case::parse(&beyond, "b.toml").unwrap_err().to_string();
+        assert!(e.contains("at most the stability limit"), "{e}");
+        let read = Case::parse_for_prescribed_motion(&beyond, "b.toml").unwrap();
+        assert_eq!(read.dt(), 3.6e-3);
+        for (from, to, msg) in [
+            ("kn = 2e5", "kn = -3.0", "contact.kn: must be > 0, got -3"),
+            (
+                "kn = 2e5",
+                "kn = 1e308",
+                "contact.kn: the free–free collision time",
+            ),
+            (
+                "density = 1.0",
+                "density = nan",
+                "material.density: a finite number expected, got NaN",
+            ),
+        ] {
+            let bad = beyond.replacen(from, to, 1);
+            let e = Case::parse_for_prescribed_motion(&bad, "b.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("b.toml:") && e.contains(msg), "{e}");
+        }
     }
 
     /// An unknown key, one in the tagged `[scene]` table, and a value of the wrong type.

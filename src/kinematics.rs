@@ -12,7 +12,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion};
 
-use crate::case::{Case, Scene};
+use crate::case::{Case, Scene, COARSE_STEPS_PER_COLLISION};
 use crate::contact::{ContactLaw, PairForce, PairInput, PairKinematics};
 use crate::engine::{self, LawVisitor};
 use crate::io::FormatError;
@@ -150,6 +150,39 @@ pub fn pair_of(case: &Case) -> anyhow::Result<([Vec3; 2], [f64; 2])> {
         [Vec3::from(sphere[0].x), Vec3::from(sphere[1].x)],
         [r(0), r(1)],
     ))
+}
+
+/// The collision time (time) of the contact of the case's scene under its law,
+/// [`Case::collision_time`] at the effective mass of the first of [`Case::pairs`] (the two
+/// spheres of a `spheres` scene of two free spheres); `None` when the scene has no contact or
+/// the law over-damps it. The time scale on which a prescribed motion has to resolve the law.
+pub fn collision_time(case: &Case) -> Option<f64> {
+    let (_, meff) = *case.pairs().first()?;
+    case.collision_time(meff)
+}
+
+/// The widest step [t_(k−1), t_k] of `rows` at whose end the spheres of radii `radius` touch
+/// (the steps whose increments the law takes, [`drive`]): its row k >= 1 and t_k − t_(k−1)
+/// (time), the earliest of equal ones; `None` when they touch at no row after the first.
+pub fn widest_contact_step(radius: [f64; 2], rows: &[MotionRow]) -> Option<(usize, f64)> {
+    // as PairInput::kinematics tells a contact
+    let sum = radius[0] + radius[1];
+    let touching = |row: &MotionRow| (row.x[1] - row.x[0]).norm_squared() < sum * sum;
+    (1..rows.len())
+        .filter(|&k| touching(&rows[k]))
+        .map(|k| (k, rows[k].t - rows[k - 1].t))
+        .fold(None, |widest, (k, dt)| match widest {
+            Some((_, w)) if w >= dt => widest,
+            _ => Some((k, dt)),
+        })
+}
+
+/// Whether steps `dt` (time) are coarse for a law of collision time `tc` (time): fewer than
+/// [`COARSE_STEPS_PER_COLLISION`] per collision, where a run of verdem's scheme is warned
+/// about. Its forces are still the law's at each row; what a coarse motion misses is the
+/// collision's course between them.
+pub fn coarse(dt: f64, tc: f64) -> bool {
+    tc / dt < COARSE_STEPS_PER_COLLISION * (1.0 - 1e-12)
 }
 
 /// Drives one contact of spheres with radii `radius` (sphere 1, sphere 2) through `rows`.
@@ -525,6 +558,22 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert_eq!(e, "f.csv:3: expected 16 columns, got 17");
+    }
+
+    #[test]
+    fn the_widest_contact_step_counts_the_steps_that_end_in_contact() {
+        // apart (gap −1e-3) at t = 1 and 4: the steps ending there are not the law's
+        let rows = [
+            still(0.0, 1e-3),
+            still(1.0, -1e-3),
+            still(1.5, 1e-3),
+            still(2.0, 1e-3),
+            still(4.0, -1e-3),
+            still(4.5, 1e-3),
+        ];
+        assert_eq!(widest_contact_step([0.5, 0.5], &rows), Some((2, 0.5)));
+        assert_eq!(widest_contact_step([0.5, 0.5], &rows[..2]), None);
+        assert!(coarse(0.5, 4.99) && !coarse(0.5, 5.0));
     }
 
     #[test]

@@ -186,6 +186,145 @@ fn the_kinematics_command_writes_the_forces_of_the_driver() {
     );
 }
 
+/// `verdem kinematics CASE MOTION --out FORCES`: its exit success, stdout and stderr.
+fn kinematics_cmd(
+    case: &std::path::Path,
+    motion: &std::path::Path,
+    forces: &std::path::Path,
+) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .arg("kinematics")
+        .arg(case)
+        .arg(motion)
+        .arg("--out")
+        .arg(forces)
+        .output()
+        .unwrap();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.success(), text(&out.stdout), text(&out.stderr))
+}
+
+/// A prescribed motion integrates nothing: `kinematics` refuses a law that is not physical, as
+/// `run` does, but not a time step beyond the scheme's stability limit, and warns about rows
+/// coarse for the law's collision time while the spheres touch, writing the forces still.
+#[test]
+fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coarse_rows() {
+    use verdem::kinematics::{drive, forces_csv, law_of, motion_csv, parse_motion, Increment};
+    let dir = tempfile::tempdir().unwrap();
+    let template =
+        std::fs::read_to_string(common::root().join("cases/verify/objectivity.toml")).unwrap();
+    let kt_line = template
+        .lines()
+        .position(|l| l.starts_with("kt = "))
+        .unwrap()
+        + 1;
+    let case_with_kt = |kt: &str| {
+        let path = dir.path().join("c.toml");
+        let text: Vec<String> = template
+            .lines()
+            .map(|l| {
+                if l.starts_with("kt = ") {
+                    format!("kt = {kt}")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect();
+        std::fs::write(&path, text.join("\n")).unwrap();
+        path
+    };
+    // kt = 1000 kn: the tangential spring at tc/50 is beyond the scheme's limit
+    let stiff = case_with_kt("2e8");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .arg("run")
+        .arg(&stiff)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && err.contains(
+                "c.toml:11: run.steps_per_collision: at most the stability limit of the \
+                 free–free tangential contact"
+            ),
+        "{err}"
+    );
+
+    let case = verdem::case::Case::load_for_prescribed_motion(&stiff).unwrap();
+    let tc = verdem::kinematics::collision_time(&case).unwrap();
+    let (x, radius) = verdem::kinematics::pair_of(&case).unwrap();
+    let start = verdem::kinematics::MotionRow {
+        t: 0.0,
+        x,
+        q: [nalgebra::UnitQuaternion::identity(); 2],
+        v: [verdem::Vec3::zeros(); 2],
+        w: [verdem::Vec3::zeros(); 2],
+    };
+    let spin = verdem::verify::objectivity::spin_sphere_2;
+    let (motion, forces) = (dir.path().join("m.csv"), dir.path().join("f.csv"));
+    let expected = |rows: &[verdem::kinematics::MotionRow]| {
+        let read = parse_motion("m", &motion_csv(rows)).unwrap();
+        forces_csv(&drive(
+            law_of(&case).as_ref(),
+            radius,
+            &read,
+            Increment::Positions,
+        ))
+    };
+
+    // fine rows while the spheres touch, then rows a collision time apart once they have parted:
+    // no warning
+    let mut rows = vec![start];
+    spin(&mut rows, verdem::Vec3::y(), 1e-3, 50, 5, case.dt());
+    for _ in 0..2 {
+        let mut apart = *rows.last().unwrap();
+        apart.t += tc;
+        apart.x[1].z += 1.0;
+        rows.push(apart);
+    }
+    std::fs::write(&motion, motion_csv(&rows)).unwrap();
+    let (ok, stdout, stderr) = kinematics_cmd(&stiff, &motion, &forces);
+    assert!(ok && stderr.is_empty(), "{stderr}");
+    assert!(stdout.starts_with(&format!("{} rows of objectivity", rows.len())));
+    assert_eq!(std::fs::read_to_string(&forces).unwrap(), expected(&rows));
+
+    // rows 2^-11 apart in contact (about tc/7, every time and step exact): a warning naming the
+    // first such row's line, and the forces
+    let coarse = 2f64.powi(-11);
+    let mut rows = vec![start];
+    spin(&mut rows, verdem::Vec3::y(), 1e-3, 8, 2, coarse);
+    std::fs::write(&motion, motion_csv(&rows)).unwrap();
+    std::fs::remove_file(&forces).unwrap();
+    let (ok, _, stderr) = kinematics_cmd(&stiff, &motion, &forces);
+    assert!(ok, "{stderr}");
+    let warning = format!(
+        "warning: {}:3: rows up to Δt = {coarse:.4e} apart while the spheres touch, coarse for \
+         this law's collision time tc = {tc:.4e} (tc/Δt = {:.3}, below 10): the forces are the \
+         law's at these rows, not an integration's",
+        motion.display(),
+        tc / coarse
+    );
+    assert!(tc / coarse < 10.0);
+    assert!(stderr.starts_with(&warning), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert_eq!(std::fs::read_to_string(&forces).unwrap(), expected(&rows));
+
+    // a law that is not physical is refused, naming file, line and field; no forces written
+    for (kt, msg) in [
+        ("-5.0", "contact.kt: must be >= 0, got -5"),
+        ("nan", "contact.kt: a finite number expected, got NaN"),
+    ] {
+        let bad = case_with_kt(kt);
+        let _ = std::fs::remove_file(&forces);
+        let (ok, _, stderr) = kinematics_cmd(&bad, &motion, &forces);
+        let at = format!("{}:{kt_line}: {msg}", bad.display());
+        assert!(!ok && stderr.contains(&at), "{kt}: {stderr}");
+        assert!(!forces.exists());
+    }
+}
+
 #[test]
 fn the_gas_conserves_momentum_and_the_cluster_angular_momentum_unless_levers_are_full_radii() {
     let rows = verdem::verify::conservation::rows(&load("conservation.toml"), 100_000).unwrap();

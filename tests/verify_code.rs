@@ -134,6 +134,64 @@ fn the_command_line_prints_the_programs_rows_and_says_what_it_skipped() {
         .all(|l| l.contains("code:positions") && l.ends_with("PASS")));
 }
 
+/// A prescribed motion integrates nothing: `verify --code` judges a case whose tangential
+/// spring is beyond the scheme's stability limit at its time step, and warns, once, when the
+/// motions' rows (the case's time step apart) are coarse for the law's collision time.
+#[test]
+fn a_case_beyond_the_stability_limit_is_judged_and_a_coarse_one_warned_about() {
+    let cmd = format!("{} kinematics", env!("CARGO_BIN_EXE_verdem"));
+    let template = std::fs::read_to_string(cases().join("objectivity.toml")).unwrap();
+    assert!(template.contains("kt = 57142.857142857145") && template.contains("= 50.0"));
+    // kt = 1000 kn: refused by `verdem run` at tc/50, and at tc/5
+    for steps_per_collision in ["50.0", "5.0"] {
+        let dir = tempfile::tempdir().unwrap();
+        let text = template
+            .replace("kt = 57142.857142857145", "kt = 2e8")
+            .replace(
+                "steps_per_collision = 50.0",
+                &format!("steps_per_collision = {steps_per_collision}"),
+            );
+        let case = dir.path().join("objectivity.toml");
+        std::fs::write(&case, text).unwrap();
+        std::fs::copy(
+            cases().join("binary_collision.toml"),
+            dir.path().join("binary_collision.toml"),
+        )
+        .unwrap();
+        assert!(Case::load(&case)
+            .unwrap_err()
+            .to_string()
+            .contains("at most the stability limit of the free–free tangential contact"));
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+            .args(["verify", "--code", &cmd, "--only", "contact loss"])
+            .arg("--cases")
+            .arg(dir.path())
+            .arg("--out")
+            .arg(dir.path().join("out"))
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&run.stdout);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{text}{err}");
+        assert!(text.contains("4 passed, 0 failed"), "{text}");
+        let case = Case::load_for_prescribed_motion(&case).unwrap();
+        let tc = kinematics::collision_time(&case).unwrap();
+        if steps_per_collision == "5.0" {
+            let warning = format!(
+                "warning: {}: run.steps_per_collision: the prescribed motions' rows, dt = {:.4e} \
+                 apart, are coarse for this law's collision time tc = {tc:.4e} (tc/dt = 5.000, \
+                 below 10)",
+                dir.path().join("objectivity.toml").display(),
+                case.dt()
+            );
+            assert!(err.starts_with(&warning), "{err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        } else {
+            assert!(err.is_empty(), "{err}");
+        }
+    }
+}
+
 /// The Python law's rows, gated as verdem's MercuryDPM law.
 fn python_rows(defect: Option<&str>) -> Vec<Row> {
     let scratch = tempfile::tempdir().unwrap();

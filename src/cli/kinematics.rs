@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use verdem::case::Case;
+use verdem::case::{Case, COARSE_STEPS_PER_COLLISION};
 use verdem::io::{self, atomic};
 use verdem::kinematics::{self, Increment};
 use verdem::peers::motion::{self, MotionPeer};
@@ -40,12 +40,28 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(&a.case)?;
+    // no integration: the law's checks, not the scheme's stability limit on run.dt
+    let case = Case::load_for_prescribed_motion(&a.case)?;
     let (file, text) = io::read_text(&a.motion)?;
     let (lines, rows): (Vec<usize>, Vec<_>) = kinematics::parse_motion_lines(&file, &text)?
         .into_iter()
         .unzip();
     let (_, radius) = kinematics::pair_of(&case)?;
+    let tc = kinematics::collision_time(&case);
+    if let (Some(tc), Some((k, dt))) = (tc, kinematics::widest_contact_step(radius, &rows)) {
+        if kinematics::coarse(dt, tc) {
+            eprintln!(
+                "warning: {file}:{}: rows up to Δt = {dt:.4e} apart while the spheres touch, \
+                 coarse for this law's collision time tc = {tc:.4e} (tc/Δt = {:.3}, below \
+                 {COARSE_STEPS_PER_COLLISION}): the forces are the law's at these rows, not an \
+                 integration's, and the collision's course between them is not seen; rows at \
+                 most tc/{COARSE_STEPS_PER_COLLISION} = {:.4e} apart resolve it",
+                lines[k],
+                tc / dt,
+                tc / COARSE_STEPS_PER_COLLISION
+            );
+        }
+    }
     let forces = match a.peer {
         None => {
             let law = kinematics::law_of(&case);

@@ -64,6 +64,9 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
                 .unwrap_or_else(|| External::default_name(cmd));
             let program = External::new(cmd, &name, &a.out.join("code"))
                 .with_timeout(Duration::from_secs_f64(a.code_timeout));
+            for warning in verify::coarse_motion_warnings(&a.cases) {
+                eprintln!("warning: {warning}");
+            }
             let subject = Subject::code(&program, a.convention);
             let entries = verify::select(verify::code_entries(&a.cases, &subject), only)?;
             let rows = verify::run(&entries)?;

@@ -275,7 +275,7 @@ pub fn case_text(case: &Case, start: &MotionRow) -> anyhow::Result<String> {
     scene.insert("sphere".into(), spheres.into());
     doc.insert("scene".into(), scene.into());
     let out = toml::to_string(&doc).context("the case as TOML")?;
-    let back = Case::parse(&out, &file)?;
+    let back = Case::parse_for_prescribed_motion(&out, &file)?;
     let (_, back_radius) = kinematics::pair_of(&back)?;
     anyhow::ensure!(
         back.contact == case.contact && back_radius == radius,

@@ -29,8 +29,9 @@ use std::path::Path;
 
 use crate::analysis::verdict::Outcome;
 use crate::analysis::{Limit, Verdict};
-use crate::case::{Case, Tangential};
+use crate::case::{Case, Tangential, COARSE_STEPS_PER_COLLISION};
 use crate::contact::registry::Properties;
+use crate::kinematics;
 pub use collision::{binary_collisions, closed_form, collide, ClosedForm, Measured};
 use driver::{MotionDriver, OWN};
 
@@ -173,7 +174,7 @@ impl MotionCase {
     /// is held to verdem's number of that convention where that convention misses the
     /// expected value (the quantity then ends in `= verdem NAME`).
     pub fn judge(&self, dir: &Path, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
-        let base = Case::load(&dir.join(self.file))?;
+        let base = Case::load_for_prescribed_motion(&dir.join(self.file))?;
         let mut rows = (self.rows)(&base, subject, variant)?;
         if let Some(conv) = subject.gated_as {
             let own = (self.rows)(&base, &Subject::own(conv), variant)?;
@@ -289,6 +290,48 @@ pub fn code_entries<'a>(dir: &'a Path, subject: &'a Subject<'a>) -> Vec<Entry<'a
         }
     }
     list
+}
+
+/// A warning for each prescribed-motion case of the folder `dir` whose motions are coarse for
+/// its law: every motion steps by the case's time step, so its rows are `run.dt` apart, and
+/// they are coarse when [`kinematics::coarse`] for the law's [`kinematics::collision_time`].
+/// A case that does not load gives none (its rows say why); each file is named once.
+pub fn coarse_motion_warnings(dir: &Path) -> Vec<String> {
+    let mut files: Vec<&str> = Vec::new();
+    for case in MOTION_CASES {
+        if !files.contains(&case.file) {
+            files.push(case.file);
+        }
+    }
+    let mut warnings = Vec::new();
+    for file in files {
+        let path = dir.join(file);
+        let Ok(case) = Case::load_for_prescribed_motion(&path) else {
+            continue;
+        };
+        let dt = case.dt();
+        let Some(tc) = kinematics::collision_time(&case).filter(|&tc| kinematics::coarse(dt, tc))
+        else {
+            continue;
+        };
+        let field = if case.run.dt.is_some() {
+            "run.dt"
+        } else {
+            "run.steps_per_collision"
+        };
+        warnings.push(format!(
+            "{}: {field}: the prescribed motions' rows, dt = {dt:.4e} apart, are coarse for this \
+             law's collision time tc = {tc:.4e} (tc/dt = {:.3}, below \
+             {COARSE_STEPS_PER_COLLISION}): the forces are the law's at these rows, not an \
+             integration's, and the collision's course between them is not seen; run.dt <= \
+             {:.4e} (tc/{COARSE_STEPS_PER_COLLISION}) or run.steps_per_collision >= \
+             {COARSE_STEPS_PER_COLLISION} resolves it",
+            path.display(),
+            tc / dt,
+            tc / COARSE_STEPS_PER_COLLISION
+        ));
+    }
+    warnings
 }
 
 /// The entries `only` selects (all of them without it); an error listing every name when it
