@@ -403,3 +403,73 @@ fn checks_by_errors_not_calibrated_at_the_sampling_are_reported_only() {
     let nu = find(&other, "symmetric nu");
     assert_ne!(nu.outcome, Outcome::Reported);
 }
+
+/// The run's profiles picture overlays its in-run profiles on the saves' (drawn again from the
+/// two tables it wrote, to the byte), and `compare --plot --inrun` overlays each table's in-run
+/// table beside it; a table without one is named.
+#[test]
+fn the_run_s_picture_and_compare_s_overlay_show_the_in_run_profiles() {
+    use verdem::analysis::cg::{plot, table::Table};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a");
+    common::verdem_ok([
+        "run",
+        "cases/shear_flow_steady.toml",
+        "--steps",
+        "40000",
+        "--save-every",
+        "4000",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let base = |ext: &str| out.join(format!("shear_flow_steady.{ext}"));
+    let saves = Table::read(&base("profiles.csv")).unwrap();
+    let inrun = Table::read(&base("profiles_inrun.csv")).unwrap();
+    let redrawn = dir.path().join("redrawn.png");
+    plot::run_png(&saves, &inrun, &redrawn).unwrap();
+    let shown = std::fs::read(base("profiles.png")).unwrap();
+    assert!(
+        shown == std::fs::read(&redrawn).unwrap(),
+        "the run drew other profiles"
+    );
+    let alone = dir.path().join("alone.png");
+    plot::overlay_png(&[(plot::SAVES_LABEL, &saves)], &alone).unwrap();
+    assert!(
+        shown != std::fs::read(&alone).unwrap(),
+        "no in-run profiles in the picture"
+    );
+
+    let overlay = dir.path().join("overlay.png");
+    let profiles = base("profiles.csv");
+    let p = profiles.to_str().unwrap();
+    let args = ["compare", p, p, "--labels", "x,y", "--inrun", "--plot"];
+    common::verdem_ok(args.iter().copied().chain([overlay.to_str().unwrap()]));
+    let want = dir.path().join("want.png");
+    let runs = [
+        ("x", &saves),
+        ("y", &saves),
+        ("x (in-run)", &inrun),
+        ("y (in-run)", &inrun),
+    ];
+    plot::overlay_png(&runs, &want).unwrap();
+    assert!(std::fs::read(&overlay).unwrap() == std::fs::read(&want).unwrap());
+
+    let lone = dir.path().join("lone.profiles.csv");
+    std::fs::copy(&profiles, &lone).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(["compare", p, lone.to_str().unwrap(), "--inrun", "--plot"])
+        .arg(&overlay)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!(
+            "--inrun: {} has no in-run table beside it ({} is missing)",
+            lone.display(),
+            dir.path().join("lone.profiles_inrun.csv").display()
+        )),
+        "{err}"
+    );
+}

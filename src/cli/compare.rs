@@ -21,6 +21,33 @@ pub struct Args {
     /// file names).
     #[arg(long, value_delimiter = ',')]
     labels: Vec<String>,
+    /// In the plot, also overlay each table's in-run profiles: the `NAME.profiles_inrun.csv`
+    /// that `verdem run` writes beside `NAME.profiles.csv`, labelled `LABEL (in-run)`.
+    #[arg(long, requires = "plot")]
+    inrun: bool,
+}
+
+/// The in-run table `verdem run` writes beside the profiles table `path`
+/// (`NAME.profiles.csv` → `NAME.profiles_inrun.csv`), or an error naming what is missing.
+fn inrun_beside(path: &std::path::Path) -> anyhow::Result<PathBuf> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let Some(base) = name.strip_suffix(".profiles.csv") else {
+        anyhow::bail!(
+            "--inrun: {} is not a run's NAME.profiles.csv, beside which its in-run table would be",
+            path.display()
+        );
+    };
+    let inrun = path.with_file_name(format!("{base}.profiles_inrun.csv"));
+    anyhow::ensure!(
+        inrun.exists(),
+        "--inrun: {} has no in-run table beside it ({} is missing)",
+        path.display(),
+        inrun.display()
+    );
+    Ok(inrun)
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -43,7 +70,17 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let rows = compare::compare(&tables[0].1, &tables[1..])?;
     print!("{}", compare::markdown(&tables[0].0, &rows));
     if let Some(png) = a.plot {
-        let runs: Vec<(&str, &Table)> = tables.iter().map(|(l, t)| (l.as_str(), t)).collect();
+        let mut inrun = Vec::new();
+        if a.inrun {
+            for (p, (label, _)) in paths.iter().zip(&tables) {
+                inrun.push((format!("{label} (in-run)"), Table::read(&inrun_beside(p)?)?));
+            }
+        }
+        let runs: Vec<(&str, &Table)> = tables
+            .iter()
+            .chain(&inrun)
+            .map(|(l, t)| (l.as_str(), t))
+            .collect();
         plot::overlay_png(&runs, &png)?;
         println!("(overlay in {})", png.display());
     }

@@ -8,7 +8,8 @@ use std::sync::Arc;
 use anyhow::Context;
 
 use verdem::analysis::cg::blocking::{self, Unit};
-use verdem::analysis::cg::{self, CgOptions};
+use verdem::analysis::cg::table::Table;
+use verdem::analysis::cg::{self, plot, CgOptions};
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::analysis::particles;
 use verdem::case::{Case, Scene};
@@ -246,6 +247,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             let errors = inrun::errors_csv_path(&opts.out_dir, &case.name);
             atomic::write(&errors, inrun::errors_csv(&r).as_bytes())?;
             println!("in-run profiles: {}", path.display());
+            let png = opts.out_dir.join(format!("{}.profiles.png", case.name));
+            plot::run_png(&Table::of(&saved), &Table::of(&r.profiles), &png)?;
             let units: Vec<Unit> = saved.per_save.iter().cloned().map(Unit::of_save).collect();
             let floor = blocking::Floor::reference(opts.save_every as f64 * case.dt());
             let save_errors = blocking::field_errors_with_floor(&units, &saved.grid, &floor);

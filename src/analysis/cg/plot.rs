@@ -196,6 +196,19 @@ pub fn profiles_png(p: &Profiles, path: &Path) -> anyhow::Result<()> {
     overlay_png(&[("", &Table::of(p))], path)
 }
 
+/// The legend of a run's profiles from its saves, in [`run_png`].
+pub const SAVES_LABEL: &str = "saves";
+
+/// The legend of a run's in-run profiles, in [`run_png`].
+pub const INRUN_LABEL: &str = "in-run";
+
+/// A run's picture of what it knows: the five benchmark profiles from its saves and those it
+/// averaged in the run (narrower bands for the stresses), each with its ±2 SE band, labelled
+/// [`SAVES_LABEL`] and [`INRUN_LABEL`].
+pub fn run_png(saves: &Table, inrun: &Table, path: &Path) -> anyhow::Result<()> {
+    overlay_png(&[(SAVES_LABEL, saves), (INRUN_LABEL, inrun)], path)
+}
+
 /// The five benchmark profiles of several runs, one labelled curve per run in each panel.
 pub fn overlay_png(runs: &[(&str, &Table)], path: &Path) -> anyhow::Result<()> {
     let mut panels: Vec<(String, Vec<Curve<'_>>)> = Vec::new();
