@@ -56,27 +56,39 @@ fn all_finite(dir: &Path) {
     }
 }
 
+/// A child process killed when dropped, so that a failed assertion leaves no run behind.
+struct Killed(std::process::Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 #[test]
 fn a_second_run_into_a_busy_folder_is_refused_naming_the_first() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
-    let mut first = Command::new(env!("CARGO_BIN_EXE_verdem"))
-        .current_dir(common::root())
-        .args([
-            "run",
-            SHEAR,
-            "--steps",
-            "100000000",
-            "--save-every",
-            "1000000",
-            "--quiet",
-            "--out",
-            out,
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut first = Killed(
+        Command::new(env!("CARGO_BIN_EXE_verdem"))
+            .current_dir(common::root())
+            .args([
+                "run",
+                SHEAR,
+                "--steps",
+                "100000000",
+                "--save-every",
+                "1000000",
+                "--quiet",
+                "--out",
+                out,
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
     let lock = dir.path().join(verdem::io::lock::LOCK_FILE);
     let deadline = Instant::now() + Duration::from_secs(60);
     while !std::fs::read_to_string(&lock).is_ok_and(|t| t.ends_with('\n')) {
@@ -93,21 +105,21 @@ fn a_second_run_into_a_busy_folder_is_refused_naming_the_first() {
         assert!(
             err.contains(&format!(
                 "{out}: another verdem run is writing into this folder (PID {}: ",
-                first.id()
+                first.0.id()
             )) && err.contains("--steps 100000000"),
             "{err}"
         );
     }
     // killed, the first run leaves its lock file, which the next run says and takes over
-    first.kill().unwrap();
-    first.wait().unwrap();
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
     assert!(lock.exists());
     let (code, _, err) = verdem(&[
         "run", SHEAR, "--steps", "10", "--quiet", "--out", out, "--force",
     ]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
-        err.contains("a run that did not end") && err.contains(&format!("PID {}", first.id())),
+        err.contains("a run that did not end") && err.contains(&format!("PID {}", first.0.id())),
         "{err}"
     );
     assert!(!lock.exists(), "a finished run leaves no lock file");
