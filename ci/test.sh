@@ -8,14 +8,15 @@ echo "== system packages"
 # The peers of the cross-runs and timings (Debian lammps, liggghts, with OpenMPI's mpirun, and
 # yade), the font the plots label their axes with (fonts-dejavu-core), and ParaView's Python
 # module (python3-paraview), whose reader opens a run's VTK files in tests/vtk.rs; the LAMMPS and
-# LIGGGHTS libraries (liblammps0, libliggghts3) that tests/peer_motion.rs drives in process.
+# LIGGGHTS libraries (liblammps0, libliggghts3) that tests/peer_motion.rs drives in process; the
+# C++ compiler (g++) that tests/examples_ci.rs builds the example C++ contact-law wrapper with.
 if ! command -v lmp >/dev/null || ! command -v liggghts >/dev/null || ! command -v mpirun >/dev/null \
    || ! ldconfig -p | grep "liblammps.so.0 " >/dev/null || ! ldconfig -p | grep "libliggghts.so.3 " >/dev/null \
-   || ! command -v yade >/dev/null \
+   || ! command -v yade >/dev/null || ! command -v g++ >/dev/null \
    || [ ! -f /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] \
    || [ ! -f /usr/lib/python3/dist-packages/paraview/simple.py ]; then
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts liblammps0 libliggghts3 openmpi-bin yade fonts-dejavu-core python3-paraview >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps liggghts liblammps0 libliggghts3 openmpi-bin yade fonts-dejavu-core python3-paraview g++ >/dev/null
 fi
 
 echo "== Slurm (a one-node cluster on localhost for tests/ensemble.rs)"
