@@ -65,14 +65,21 @@ fn python_reads(xml: &Path, json: &Path) -> Value {
 /// JSON report read with serde_json, and both reports as Python read them.
 fn verify(args: &[&str]) -> (Option<i32>, String, Value, Value) {
     let dir = tempfile::tempdir().unwrap();
-    let (xml, json) = (dir.path().join("r.xml"), dir.path().join("r.json"));
-    let run = Command::new(env!("CARGO_BIN_EXE_verdem"))
+    let mut command = Command::new(env!("CARGO_BIN_EXE_verdem"));
+    command
         .arg("verify")
         .args(args)
         .arg("--cases")
         .arg(common::root().join("cases/verify"))
         .arg("--out")
-        .arg(dir.path().join("out"))
+        .arg(dir.path().join("out"));
+    reports(command, dir.path())
+}
+
+/// `command` run with `--junit` and `--json` files in `dir`: as [`verify`].
+fn reports(mut command: Command, dir: &Path) -> (Option<i32>, String, Value, Value) {
+    let (xml, json) = (dir.join("r.xml"), dir.join("r.json"));
+    let run = command
         .arg("--junit")
         .arg(&xml)
         .arg("--json")
@@ -102,18 +109,38 @@ fn text_rows(stdout: &str, first: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-/// The JSON, junitparser's and the text table's rows agree one for one, and so do the counts.
+/// The JSON, junitparser's and the verification table's rows agree one for one, and so do the
+/// counts with the table's summary line.
 fn same_rows(stdout: &str, first: &str, table: &Value, python: &Value) {
     let rows = text_rows(stdout, first);
+    same_cases(&rows, "verdem verify", table, python);
     let cases = table["cases"].as_array().unwrap();
-    assert_eq!(cases.len(), rows.len(), "{stdout}");
+    let count = |s: &str| cases.iter().filter(|c| c["status"] == s).count();
+    for ((line, _), c) in rows.iter().zip(cases) {
+        // the row's case and quantity begin the table's line
+        assert!(
+            line.starts_with(c["group"].as_str().unwrap()),
+            "{line}\n{c}"
+        );
+        assert!(line.contains(c["name"].as_str().unwrap()), "{line}\n{c}");
+    }
+    // the summary line counts the same
+    let summary = format!("{} passed, {} failed", count("passed"), count("failed"));
+    assert!(stdout.contains(&summary), "{summary}\n{stdout}");
+}
+
+/// The JSON's and junitparser's cases of the suite `suite_name` agree one for one with the
+/// command's text `rows` (line, result word), and so do the counts.
+fn same_cases(rows: &[(String, String)], suite_name: &str, table: &Value, python: &Value) {
+    let cases = table["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), rows.len(), "{rows:?}");
     assert_eq!(table["tests"], rows.len());
     // Python's json reads the same table
     assert_eq!(&python["json"], table);
     let suites = python["junit"].as_array().unwrap();
     assert_eq!(suites.len(), 1, "{python}");
     let suite = &suites[0];
-    assert_eq!(suite["name"], "verdem verify");
+    assert_eq!(suite["name"], suite_name);
     for key in ["tests", "failures", "skipped"] {
         assert_eq!(suite[key], table[key], "{key}");
     }
@@ -122,12 +149,6 @@ fn same_rows(stdout: &str, first: &str, table: &Value, python: &Value) {
     assert_eq!(xml_cases.len(), cases.len());
     let count = |s: &str| cases.iter().filter(|c| c["status"] == s).count();
     for ((line, word), (c, x)) in rows.iter().zip(cases.iter().zip(xml_cases)) {
-        // the row's case and quantity begin the table's line, its word ends it
-        assert!(
-            line.starts_with(c["group"].as_str().unwrap()),
-            "{line}\n{c}"
-        );
-        assert!(line.contains(c["name"].as_str().unwrap()), "{line}\n{c}");
         assert_eq!(c["result"], word.as_str(), "{line}");
         let status = match word.as_str() {
             "PASS" => "passed",
@@ -148,9 +169,6 @@ fn same_rows(stdout: &str, first: &str, table: &Value, python: &Value) {
     assert_eq!(table["passed"], count("passed"));
     assert_eq!(table["failures"], count("failed"));
     assert_eq!(table["skipped"], count("skipped"));
-    // the summary line counts the same
-    let summary = format!("{} passed, {} failed", count("passed"), count("failed"));
-    assert!(stdout.contains(&summary), "{summary}\n{stdout}");
 }
 
 /// The expected, measured and tolerance of a message `expected E, measured M, tolerance T
@@ -250,4 +268,57 @@ fn verify_code_failures_are_junit_failures_with_their_numbers() {
         m.starts_with("could not be measured: ") && m.contains("RuntimeError: the law diverged"),
         "{m}"
     );
+}
+
+/// `verdem cg` writes the checks it prints (`PASS  QUANTITY: …`), a FAIL as a failure and an
+/// info line as a skipped case, without changing its exit status (the checks are a report).
+#[test]
+fn cg_writes_its_checks() {
+    let case = common::quick_case();
+    let dir = tempfile::tempdir().unwrap();
+    let mut e = common::engine(
+        &case,
+        Some(&common::data("states/mercury_t143.85.data")),
+        Default::default(),
+    );
+    common::run_with_saves(e.as_mut(), dir.path(), "s", 2000, 500);
+    let mut command = Command::new(env!("CARGO_BIN_EXE_verdem"));
+    command.arg("cg").arg(dir.path().join("s"));
+    let (status, stdout, table, python) = reports(command, dir.path());
+    assert_eq!(status, Some(0), "{stdout}");
+    // the check lines: the word, two spaces, `QUANTITY: MEASURED (expected EXPECTED)`
+    let rows: Vec<(String, String)> = stdout
+        .lines()
+        .filter_map(|l| {
+            let (word, rest) = l.split_at_checked(6)?;
+            let word = word.trim_end();
+            ["PASS", "FAIL", "info"]
+                .contains(&word)
+                .then(|| (rest.to_string(), word.to_string()))
+        })
+        .collect();
+    same_cases(&rows, "verdem cg", &table, &python);
+    for ((line, _), c) in rows.iter().zip(table["cases"].as_array().unwrap()) {
+        // the check's quantity begins its line, and its measurement in words is the message's
+        let name = c["name"].as_str().unwrap();
+        let measured = line
+            .strip_prefix(&format!("{name}: "))
+            .unwrap_or_else(|| panic!("{line}\n{c}"));
+        assert_eq!(c["group"], "verdem cg");
+        let measured = measured.split(" (expected ").next().unwrap();
+        assert!(
+            c["message"].as_str().unwrap().contains(measured),
+            "{line}\n{c}"
+        );
+    }
+    let cases = table["cases"].as_array().unwrap();
+    let mass = cases
+        .iter()
+        .find(|c| c["name"].as_str().unwrap().starts_with("mass"));
+    assert_eq!(mass.unwrap()["status"], "passed", "{table}");
+    // the ledgers' checks, printed after the profiles', are cases too
+    assert!(cases
+        .iter()
+        .any(|c| c["name"].as_str().unwrap().starts_with("energy ledger")));
+    assert!(table["tests"].as_u64() > Some(3), "{table}");
 }

@@ -232,7 +232,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         println!("particles: {}", png.display());
     }
     if s.saves > 0 && shear {
-        let (saved, mut report) =
+        let (saved, _, mut report) =
             cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
         println!(
             "profiles: {}",
