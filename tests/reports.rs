@@ -270,6 +270,65 @@ fn verify_code_failures_are_junit_failures_with_their_numbers() {
     );
 }
 
+/// The lines of a checks report (`cg`'s, `run`'s): (the line after its word, the word `PASS`,
+/// `FAIL` or `info`).
+fn check_lines(stdout: &str) -> Vec<(String, String)> {
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let (word, rest) = l.split_at_checked(6)?;
+            let word = word.trim_end();
+            ["PASS", "FAIL", "info"]
+                .contains(&word)
+                .then(|| (rest.to_string(), word.to_string()))
+        })
+        .collect()
+}
+
+/// `verdem run` writes the checks it prints: the saves' profiles and ledgers, the in-run
+/// profiles' and the core means of the two beside each other, in that order; its exit status
+/// stays 0 with failing checks.
+#[test]
+fn run_writes_its_checks_of_saves_and_in_run_profiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut command = Command::new(env!("CARGO_BIN_EXE_verdem"));
+    command
+        .arg("run")
+        .arg(common::root().join("cases/shear_flow_quick.toml"))
+        .arg("--init")
+        .arg(common::data("states/mercury_t143.85.data"))
+        .args([
+            "--steps",
+            "4000",
+            "--save-every",
+            "500",
+            "--inrun-every",
+            "10",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir.path().join("out"));
+    let (status, stdout, table, python) = reports(command, dir.path());
+    assert_eq!(status, Some(0), "{stdout}");
+    let rows = check_lines(&stdout);
+    same_cases(&rows, "verdem run", &table, &python);
+    let groups: Vec<&str> = table["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["group"].as_str().unwrap())
+        .collect();
+    let mut order = groups.clone();
+    order.dedup();
+    assert_eq!(order, ["saves", "in-run", "saves vs in-run"], "{groups:?}");
+    // the six core means compared
+    assert_eq!(
+        groups.iter().filter(|g| **g == "saves vs in-run").count(),
+        6
+    );
+    assert!(table["failures"].as_u64() > Some(0), "{table}");
+}
+
 /// `verdem cg` writes the checks it prints (`PASS  QUANTITY: …`), a FAIL as a failure and an
 /// info line as a skipped case, without changing its exit status (the checks are a report).
 #[test]
@@ -287,16 +346,7 @@ fn cg_writes_its_checks() {
     let (status, stdout, table, python) = reports(command, dir.path());
     assert_eq!(status, Some(0), "{stdout}");
     // the check lines: the word, two spaces, `QUANTITY: MEASURED (expected EXPECTED)`
-    let rows: Vec<(String, String)> = stdout
-        .lines()
-        .filter_map(|l| {
-            let (word, rest) = l.split_at_checked(6)?;
-            let word = word.trim_end();
-            ["PASS", "FAIL", "info"]
-                .contains(&word)
-                .then(|| (rest.to_string(), word.to_string()))
-        })
-        .collect();
+    let rows = check_lines(&stdout);
     same_cases(&rows, "verdem cg", &table, &python);
     for ((line, _), c) in rows.iter().zip(table["cases"].as_array().unwrap()) {
         // the check's quantity begins its line, and its measurement in words is the message's
