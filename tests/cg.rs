@@ -221,7 +221,7 @@ fn coarse_grains_a_series_verdem_wrote() {
     common::run_with_saves(e.as_mut(), dir.path(), "s", 2000, 500);
     let mut o = options(480, KernelChoice::Heaviside);
     o.slices = 100;
-    let (p, report) = cg::write_all(&dir.path().join("s"), &o).unwrap();
+    let (p, _, report) = cg::write_all(&dir.path().join("s"), &o).unwrap();
     assert!(report.contains("PASS  mass"), "{report}");
     assert!(dir.path().join("s.profiles.png").exists());
     let csv = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();

@@ -811,8 +811,13 @@ pub fn csv(r: &InrunResult) -> String {
 /// The in-run part of `checks.txt`: how the samples were taken, each field's autocorrelation
 /// time and blocks, the checks of the in-run profiles, and the core means of the pressure and
 /// shear stress beside those of the saves (`saves`, with the saves' own per-field errors
-/// `save_errors`), with the ratio of their standard errors.
-pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> String {
+/// `save_errors`), with the ratio of their standard errors. Also returns their verdicts, in the
+/// report's order: the in-run checks (case `in-run`), the core means (case `saves vs in-run`).
+pub fn report(
+    r: &InrunResult,
+    saves: &Profiles,
+    save_errors: &FieldErrors,
+) -> (String, Vec<Verdict>) {
     let s = r.sampling;
     let p = &r.profiles;
     let mut out = format!(
@@ -849,7 +854,15 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
         out.push_str(blocking::SLOW_MODE_NOTE);
     }
     out.push_str("checks of the in-run profiles:\n");
-    let report = checks::report(p, &checks::run(p, r.density));
+    let in_run_checks = checks::run(p, r.density);
+    let report = checks::report(p, &in_run_checks);
+    let mut verdicts: Vec<Verdict> = in_run_checks
+        .into_iter()
+        .map(|c| Verdict {
+            case: "in-run".into(),
+            ..c
+        })
+        .collect();
     // The first line of the saves' report speaks of saves; the in-run one is above, and the
     // in-run series is one of bins.
     for line in report.lines().skip(1) {
@@ -862,7 +875,7 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
          combined SE:\n",
     );
     if core_range(&p.grid).is_empty() {
-        return out;
+        return (out, verdicts);
     }
     let save_units: Vec<Unit> = saves.per_save.iter().cloned().map(Unit::of_save).collect();
     let of_saves = blocking::core_means(&save_units, &saves.grid, save_errors);
@@ -897,8 +910,12 @@ pub fn report(r: &InrunResult, saves: &Profiles, save_errors: &FieldErrors) -> S
              {sb:.2e} ({:.1} dof)   SE ratio {ratio}\n",
             s.dof, i.dof
         ));
+        verdicts.push(Verdict {
+            case: "saves vs in-run".into(),
+            ..verdict
+        });
     }
-    out
+    (out, verdicts)
 }
 
 #[cfg(test)]

@@ -184,17 +184,18 @@ pub fn checks(records: &[LedgerRecord], saves: &[u64]) -> Vec<Verdict> {
 
 /// The ledger section of `checks.txt` for the run `dir/name` over the profiles' `saves`: a
 /// heading line, then one line per verdict as the other checks print them; a note instead when
-/// the run has no diagnostics table or a table without ledgers.
-pub fn section(dir: &Path, name: &str, saves: &[u64]) -> anyhow::Result<String> {
+/// the run has no diagnostics table or a table without ledgers. Also returns the verdicts (none
+/// with a note).
+pub fn section(dir: &Path, name: &str, saves: &[u64]) -> anyhow::Result<(String, Vec<Verdict>)> {
     let path = dir.join(format!("{name}.diagnostics.csv"));
     let mut s = String::from("ledgers (every step, from the diagnostics' ledger columns):\n");
     if !path.exists() {
         s.push_str("info  no diagnostics table: no ledgers\n");
-        return Ok(s);
+        return Ok((s, Vec::new()));
     }
     let Some(records) = read_ledgers(&path)? else {
         s.push_str("info  the diagnostics table has no ledger columns (an older run)\n");
-        return Ok(s);
+        return Ok((s, Vec::new()));
     };
     let verdicts = checks(&records, saves);
     if verdicts.is_empty() {
@@ -203,7 +204,7 @@ pub fn section(dir: &Path, name: &str, saves: &[u64]) -> anyhow::Result<String> 
     for c in &verdicts {
         s.push_str(&crate::analysis::cg::checks::line(c));
     }
-    Ok(s)
+    Ok((s, verdicts))
 }
 
 #[cfg(test)]

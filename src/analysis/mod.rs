@@ -4,7 +4,7 @@
 //! results compared by their core means ([`difference`]), and the
 //! speed/accuracy trade of the shear case ([`tradeoff`]), the merge of an ensemble's profiles
 //! ([`ensemble`]), a picture of a save's particles
-//! ([`particles`]).
+//! ([`particles`]), verdicts as JUnit XML and JSON reports for CI systems ([`report`]).
 
 pub mod cg;
 pub mod difference;
@@ -12,6 +12,7 @@ pub mod ensemble;
 pub mod inrun;
 pub mod ledger;
 pub mod particles;
+pub mod report;
 pub mod stats;
 pub mod tradeoff;
 pub mod verdict;

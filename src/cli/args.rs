@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use verdem::analysis::cg::{self, Series};
+use verdem::analysis::report::Report;
+use verdem::analysis::Verdict;
 use verdem::case::Case;
 use verdem::engine::{self, Overrides};
 use verdem::scene;
@@ -44,6 +46,36 @@ pub struct Common {
     /// held, as a fraction of what it took (> 0; replaces the case's `[guard] contact`).
     #[arg(long, allow_negative_numbers = true, value_parser = positive)]
     guard_contact: Option<f64>,
+}
+
+/// Where a command that judges writes its verdicts for a CI system (`--junit`, `--json`).
+#[derive(clap::Args, Clone)]
+pub struct Reports {
+    /// Also write the verdicts as a JUnit XML report to this file: one test case per row, its
+    /// expected, measured and tolerance in the message; rows that do not gate (FAIL*, info)
+    /// are skipped with the reason.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// Also write the verdicts as a JSON table to this file (docs/cli.md, "Reports for CI").
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+}
+
+impl Reports {
+    /// Writes the suite `suite` of `verdicts` to the files asked for (none: nothing), each
+    /// with the word `result` gives it in the command's text table.
+    pub fn write(
+        &self,
+        suite: &str,
+        verdicts: &[Verdict],
+        result: impl Fn(&Verdict) -> String,
+    ) -> anyhow::Result<()> {
+        if self.junit.is_some() || self.json.is_some() {
+            Report::new(suite, verdicts, result)
+                .write(self.junit.as_deref(), self.json.as_deref())?;
+        }
+        Ok(())
+    }
 }
 
 impl Common {

@@ -42,6 +42,8 @@ pub struct Args {
     /// (without it such a save is an error).
     #[arg(long)]
     skip_incomplete: bool,
+    #[command(flatten)]
+    reports: super::args::Reports,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -64,7 +66,9 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         &format!("--slices {} over {} saves", a.slices, series.saves.len()),
         a.slices as f64 * 64.0 * 8.0 * (series.saves.len() + a.blocks) as f64,
     )?;
-    let (_, report) = cg::write_series(&series, &o)?;
+    let (_, checks, report) = cg::write_series(&series, &o)?;
     print!("{report}");
+    a.reports
+        .write("verdem cg", &checks, |c| cg::checks::result(c).into())?;
     Ok(Finished::Done)
 }

@@ -12,6 +12,7 @@ use verdem::analysis::cg::table::Table;
 use verdem::analysis::cg::{self, plot, CgOptions};
 use verdem::analysis::inrun::{self, Inrun};
 use verdem::analysis::particles;
+use verdem::analysis::Verdict;
 use verdem::case::{Case, Scene};
 use verdem::io::lock::{self, FolderLock};
 use verdem::io::vtk::Particle;
@@ -28,6 +29,8 @@ use super::Finished;
 pub struct Args {
     #[command(flatten)]
     common: Common,
+    #[command(flatten)]
+    reports: super::args::Reports,
     /// The run ends at this step (default: the case's `run.steps`), also after --resume.
     #[arg(long)]
     steps: Option<u64>,
@@ -232,9 +235,15 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     if let Some(png) = particles_picture(&opts, engine.as_ref())? {
         println!("particles: {}", png.display());
     }
+    // The checks printed, for the reports a CI system reads: none without profiles.
+    let mut verdicts = Vec::new();
     if s.saves > 0 && shear {
-        let (saved, mut report) =
+        let (saved, checks, mut report) =
             cg::write_all(&opts.out_dir.join(&case.name), &CgOptions::for_case(&case))?;
+        verdicts.extend(checks.into_iter().map(|c| Verdict {
+            case: "saves".into(),
+            ..c
+        }));
         println!(
             "profiles: {}",
             opts.out_dir
@@ -252,7 +261,9 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             let units: Vec<Unit> = saved.per_save.iter().cloned().map(Unit::of_save).collect();
             let floor = blocking::Floor::reference(opts.save_every as f64 * case.dt());
             let save_errors = blocking::field_errors_with_floor(&units, &saved.grid, &floor);
-            report.push_str(&inrun::report(&r, &saved, &save_errors));
+            let (text, inrun_verdicts) = inrun::report(&r, &saved, &save_errors);
+            report.push_str(&text);
+            verdicts.extend(inrun_verdicts);
             let checks = opts.out_dir.join(format!("{}.checks.txt", case.name));
             atomic::write(&checks, report.as_bytes())?;
         }
@@ -263,6 +274,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
              scene; `verdem cg` coarse-grains these saves all the same)"
         );
     }
+    a.reports
+        .write("verdem run", &verdicts, |c| cg::checks::result(c).into())?;
     Ok(Finished::Done)
 }
 

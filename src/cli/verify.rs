@@ -52,6 +52,8 @@ pub struct Args {
     /// Where the peers' collision runs and the program's files go.
     #[arg(long, default_value = "out/verify")]
     out: PathBuf,
+    #[command(flatten)]
+    reports: super::args::Reports,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -125,6 +127,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         },
         rows.len() - passed - failed
     );
+    a.reports
+        .write("verdem verify", &rows, |r| verify::result(r).into())?;
     Ok(if failed > 0 {
         Finished::ChecksFailed
     } else {

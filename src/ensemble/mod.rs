@@ -324,7 +324,7 @@ impl Plan {
             inrun.as_mut().map(|i| i as &mut dyn run::Observer),
         )?;
         run::write_summary(&dir, &case.name, &s, 1)?;
-        let (profiles, _) = cg::write_all(&dir.join(&case.name), &CgOptions::for_case(&case))?;
+        let (profiles, _, _) = cg::write_all(&dir.join(&case.name), &CgOptions::for_case(&case))?;
         let mut inrun_dof = Vec::new();
         if let Some(r) = inrun.as_ref().and_then(Inrun::result) {
             atomic::write(

@@ -399,13 +399,20 @@ pub fn table(rows: &[Row]) -> String {
             r.limit.expected(),
             r.measured,
             tol,
-            match (r.pass(), r.gate) {
-                (Some(true), _) => "PASS",
-                (Some(false), true) => "FAIL",
-                (Some(false), false) => "FAIL*",
-                (None, _) => "info",
-            }
+            result(r)
         ));
     }
     s
+}
+
+/// The table's word for `r`: `PASS`, `FAIL`, `FAIL*` (a failure that documents a peer
+/// convention's known defect), `ERROR` ([`is_error`]) or `info` (not judged).
+pub fn result(r: &Row) -> &'static str {
+    match (is_error(r), r.pass(), r.gate) {
+        (true, _, _) => "ERROR",
+        (false, Some(true), _) => "PASS",
+        (false, Some(false), true) => "FAIL",
+        (false, Some(false), false) => "FAIL*",
+        (false, None, _) => "info",
+    }
 }

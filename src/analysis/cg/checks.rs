@@ -440,15 +440,22 @@ pub fn run(p: &Profiles, density: f64) -> Vec<Check> {
 /// One line of a checks report: PASS, FAIL or info, what was judged, the measurement and
 /// what was expected.
 pub fn line(c: &Check) -> String {
-    let verdict = match c.pass() {
+    format!(
+        "{:4}  {}: {} (expected {})\n",
+        result(c),
+        c.quantity,
+        c.measured_text,
+        c.expected_text
+    )
+}
+
+/// The report's word for `c`: `PASS`, `FAIL` or `info` (undecided or not judged).
+pub fn result(c: &Check) -> &'static str {
+    match c.pass() {
         Some(true) => "PASS",
         Some(false) => "FAIL",
         None => "info",
-    };
-    format!(
-        "{verdict:4}  {}: {} (expected {})\n",
-        c.quantity, c.measured_text, c.expected_text
-    )
+    }
 }
 
 /// A plain-text table of the checks, with the averaging facts a reviewer needs.

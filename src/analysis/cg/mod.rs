@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::analysis::stats::{block, integrated_autocorrelation, standard_error};
 use crate::io::mercury;
 use crate::state::Domain;
+use checks::Check;
 use fields::{derive, raw_fields, Derived, Grid, Raw};
 use kernel::Kernel;
 use table::Table;
@@ -652,23 +653,27 @@ pub fn csv(p: &Profiles) -> String {
 }
 
 /// Coarse-grains `base` and writes `NAME.profiles.csv`, `NAME.profiles.png` and
-/// `NAME.checks.txt` beside it; returns the profiles and the checks' report.
-pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
+/// `NAME.checks.txt` beside it; returns the profiles, the checks (the profiles' and the
+/// ledgers', in the report's order) and the checks' report.
+pub fn write_all(base: &Path, o: &CgOptions) -> anyhow::Result<(Profiles, Vec<Check>, String)> {
     write_series(&Series::find(base)?, o)
 }
 
 /// As [`write_all`], for the saves of `series`.
-pub fn write_series(series: &Series, o: &CgOptions) -> anyhow::Result<(Profiles, String)> {
+pub fn write_series(
+    series: &Series,
+    o: &CgOptions,
+) -> anyhow::Result<(Profiles, Vec<Check>, String)> {
     let p = coarse_grain(series, o)?;
     let out = |ext: &str| series.dir.join(format!("{}.{ext}", series.name));
     crate::io::atomic::write(&out("profiles.csv"), csv(&p).as_bytes())?;
-    let mut report = checks::report(&p, &checks::run(&p, o.density));
-    report.push_str(&crate::analysis::ledger::section(
-        &series.dir,
-        &series.name,
-        &p.saves,
-    )?);
+    let mut checks = checks::run(&p, o.density);
+    let mut report = checks::report(&p, &checks);
+    let (ledgers, ledger_checks) =
+        crate::analysis::ledger::section(&series.dir, &series.name, &p.saves)?;
+    report.push_str(&ledgers);
+    checks.extend(ledger_checks);
     crate::io::atomic::write(&out("checks.txt"), report.as_bytes())?;
     plot::profiles_png(&p, &out("profiles.png"))?;
-    Ok((p, report))
+    Ok((p, checks, report))
 }
