@@ -30,7 +30,8 @@ bash ci/slurm_local.sh
 export VERDEM_SLURM=1
 
 echo "== Python packages (virtual environment target/venv)"
-# Kratos DEM (a peer) and meshio (an independent VTK reader), pinned in ci/requirements.txt.
+# Kratos DEM (a peer), meshio (an independent VTK reader) and junitparser (an independent JUnit
+# reader of the --junit reports), pinned in ci/requirements.txt.
 # The tests find this Python through VERDEM_PYTHON; verdem also finds it unset (docs/cli.md,
 # "verdem peers").
 stamp=target/venv/requirements.sha256
