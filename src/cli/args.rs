@@ -9,6 +9,7 @@ use verdem::analysis::report::Report;
 use verdem::analysis::Verdict;
 use verdem::case::Case;
 use verdem::engine::{self, Overrides};
+use verdem::io::lock::{self, FolderLock};
 use verdem::scene;
 use verdem::step::Engine;
 
@@ -105,6 +106,20 @@ impl Common {
         }
         Ok((case, engine))
     }
+}
+
+/// Makes the output folder `dir` and takes its lock ([`lock::lock_folder`]) before anything
+/// is written there; says on stderr when it takes over the lock of a run that did not end.
+pub fn lock_output_folder(dir: &Path) -> anyhow::Result<FolderLock> {
+    let lock = lock::lock_folder(dir)?;
+    if let Some(holder) = lock.stale() {
+        eprintln!(
+            "warning: {}: a run that did not end (killed, or its machine stopped) had locked \
+             this folder ({holder}); its lock is taken over",
+            dir.display()
+        );
+    }
+    Ok(lock)
 }
 
 /// The saves of the series `base` (`DIR/NAME`) for a command that reads both files of every

@@ -3,14 +3,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
-
 use verdem::case::{Case, Tangential};
-use verdem::io::lock::{self, FolderLock};
 use verdem::peers::{cross, Peer};
 use verdem::run;
 
-use super::args::{count, described};
+use super::args::{count, described, lock_output_folder};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -65,9 +62,7 @@ pub struct Args {
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let case = Case::load(&a.case)?;
     let out = a.out.join(a.peer.binary());
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("{}: cannot create output folder", out.display()))?;
-    let lock = FolderLock::take(&out, &lock::this_command())?;
+    let lock = lock_output_folder(&out)?;
     for series in [a.peer.binary(), "verdem"] {
         run::claim_output_folder(&out.join(series), &case.name, a.force, "--force", &lock)?;
     }

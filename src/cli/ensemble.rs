@@ -10,9 +10,8 @@ use anyhow::Context;
 
 use verdem::case::Case;
 use verdem::ensemble::{self, local, slurm, Plan, ReplicaCommand};
-use verdem::io::lock::{self, FolderLock};
 
-use super::args::{count, named, non_negative, positive};
+use super::args::{count, lock_output_folder, named, non_negative, positive};
 use super::signals::{self, Graceful};
 use super::Finished;
 
@@ -134,17 +133,8 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     if !a.merge {
         plan.check()?;
     }
-    std::fs::create_dir_all(&plan.out)
-        .with_context(|| format!("{}: cannot create", plan.out.display()))?;
     // Held until the merged files are written.
-    let lock = FolderLock::take(&plan.out, &lock::this_command())?;
-    if let Some(holder) = lock.stale() {
-        eprintln!(
-            "warning: {}: an ensemble that did not end had locked this folder ({holder}); its \
-             lock is taken over",
-            plan.out.display()
-        );
-    }
+    let _lock = lock_output_folder(&plan.out)?;
     let engine = if a.merge {
         "merge"
     } else {

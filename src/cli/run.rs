@@ -5,8 +5,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use anyhow::Context;
-
 use verdem::analysis::cg::blocking::{self, Unit};
 use verdem::analysis::cg::table::Table;
 use verdem::analysis::cg::{self, plot, CgOptions};
@@ -14,14 +12,13 @@ use verdem::analysis::inrun::{self, Inrun};
 use verdem::analysis::particles;
 use verdem::analysis::Verdict;
 use verdem::case::{Case, Scene};
-use verdem::io::lock::{self, FolderLock};
 use verdem::io::vtk::Particle;
 use verdem::io::{atomic, checkpoint, mercury};
 use verdem::run::{self, RunOptions, BENCHMARK_STEPS};
 use verdem::state::Motion;
 use verdem::step::Engine;
 
-use super::args::{count, Common};
+use super::args::{count, lock_output_folder, Common};
 use super::signals::{self, Graceful};
 use super::Finished;
 
@@ -113,16 +110,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         (None, Some(ck)) => checkpoint_folder(ck).to_path_buf(),
         (None, None) => PathBuf::from("out").join(&case.name),
     };
-    std::fs::create_dir_all(&out_dir)
-        .with_context(|| format!("{}: cannot create output folder", out_dir.display()))?;
-    let lock = FolderLock::take(&out_dir, &lock::this_command())?;
-    if let Some(holder) = lock.stale() {
-        eprintln!(
-            "warning: {}: a run that did not end (killed, or its machine stopped) had locked \
-             this folder ({holder}); its lock is taken over",
-            out_dir.display()
-        );
-    }
+    let lock = lock_output_folder(&out_dir)?;
     // A resumed run continues in its checkpoint's folder, which holds its saves by design.
     let own_folder = |ck: &PathBuf| {
         let canonical = |p: &Path| std::fs::canonicalize(p).ok();

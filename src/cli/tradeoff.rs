@@ -7,10 +7,9 @@ use anyhow::Context;
 use verdem::analysis::tradeoff::{self, Plan};
 use verdem::case::Case;
 use verdem::io::atomic;
-use verdem::io::lock::{self, FolderLock};
 use verdem::run;
 
-use super::args::{count, fraction, positive};
+use super::args::{count, fraction, lock_output_folder, positive};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -69,9 +68,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         return Ok(Finished::Done);
     }
     let pair = Case::load(&a.pair)?;
-    std::fs::create_dir_all(&a.out)
-        .with_context(|| format!("{}: cannot create output folder", a.out.display()))?;
-    let lock = FolderLock::take(&a.out, &lock::this_command())?;
+    let lock = lock_output_folder(&a.out)?;
     for variant in std::fs::read_dir(&a.out).into_iter().flatten().flatten() {
         if !variant.path().is_dir() {
             continue;

@@ -30,7 +30,7 @@ use crate::analysis::ensemble::{self as merge, CoreCoverage, Coverage};
 use crate::analysis::inrun::{self, Inrun};
 use crate::case::Case;
 use crate::engine::{self, Overrides};
-use crate::io::lock::{self, FolderLock};
+use crate::io::lock;
 use crate::io::{atomic, hash};
 use crate::run::{self, RunOptions};
 use crate::scene;
@@ -300,9 +300,7 @@ impl Plan {
         );
         let start_hash = hash::state_hash(&engine.snapshot());
         let dir = replica_dir(&self.out, k);
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
-        let lock = FolderLock::take(&dir, &lock::this_command())?;
+        let lock = lock::lock_folder(&dir)?;
         run::claim_output_folder(&dir, &case.name, true, "--replica", &lock)?;
         let opts = RunOptions {
             end_step: self.steps.unwrap_or(case.run.steps),

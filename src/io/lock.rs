@@ -130,6 +130,17 @@ impl Drop for FolderLock {
     }
 }
 
+/// Creates the output folder `dir` (and its parents) where it does not exist, then takes its
+/// lock for this process ([`FolderLock::take`], with [`this_command`] as the holder's name).
+pub fn lock_folder(dir: &Path) -> Result<FolderLock, LockError> {
+    std::fs::create_dir_all(dir).map_err(|source| LockError::Io {
+        file: dir.display().to_string(),
+        what: "create the output folder",
+        source,
+    })?;
+    FolderLock::take(dir, &this_command())
+}
+
 /// The holder a lock file's text names, for a message.
 fn describe(text: &str) -> String {
     match text.lines().next().map(str::trim) {
