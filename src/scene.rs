@@ -38,6 +38,8 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
     let rho = case.material.density;
     let mut particles = Particles::default();
     let mut time = 0.0;
+    // An initial file and the line of each of its particles, checked once they are placed.
+    let mut from_file = None;
     match &case.scene {
         SceneSpec::BumpyShear {
             free,
@@ -111,7 +113,7 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                         ),
                     }
                 }
-                check_loaded(&path, &loaded.line, &particles, &domain, case.guard.overlap)?;
+                from_file = Some((path, loaded.line));
             } else {
                 for (g, (pos, vx)) in walls.iter().enumerate() {
                     for x in pos {
@@ -164,10 +166,14 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
             }
         }
     }
+    // before any pair is searched: the overlaps of an initial file's spheres below
+    pairs_fit(&particles, case.neighbor.skin)?;
+    if let Some((path, line)) = &from_file {
+        check_loaded(path, line, &particles, &domain, case.guard.overlap)?;
+    }
     for x in particles.x.iter_mut() {
         domain.wrap(x);
     }
-    pairs_fit(&particles, case.neighbor.skin)?;
     Ok(Scene {
         domain,
         particles,
@@ -257,7 +263,6 @@ fn check_loaded(
             );
         }
     }
-    pairs_fit(p, 0.0)?;
     let free = |a: usize| matches!(p.motion[a], Motion::Free);
     for (a, b) in overlapping_pairs(p, domain) {
         if !free(a) && !free(b) {
