@@ -49,7 +49,7 @@ impl Raw {
         kernel: Kernel,
         area: f64,
     ) {
-        let vol = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+        let vol = sphere_volume(radius);
         let m = vol * density;
         for k in grid.near(z, z, kernel.reach()) {
             let w = kernel.point(z, grid.z(k)) / area;
@@ -121,6 +121,12 @@ impl Grid {
         let hi = (((a.max(b) + reach - self.z0) / h).ceil() + 1.0).max(0.0) as usize;
         lo.min(self.n)..hi.min(self.n)
     }
+}
+
+/// The volume 4/3 π r³ of a sphere of radius `r` (length³), which the fields weigh a particle
+/// by (times the density for its mass).
+pub fn sphere_volume(r: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * r.powi(3)
 }
 
 /// Raw fields of one save. `is_wall(i)` tells wall particles (no volume, mass or momentum);

@@ -469,7 +469,7 @@ pub fn coarse_grain(series: &Series, o: &CgOptions) -> anyhow::Result<Profiles> 
     let free = head.rows.len().saturating_sub(walls);
     let free_volume = head.rows[walls.min(head.rows.len())..]
         .iter()
-        .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.radius.powi(3))
+        .map(|r| fields::sphere_volume(r.radius))
         .sum();
     let core = core_range(&grid);
     let derived: Vec<Vec<Derived>> = per_save.iter().map(derive).collect();
@@ -527,7 +527,7 @@ fn usable(
         if is_wall(i) {
             continue;
         }
-        let m = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3) * density;
+        let m = fields::sphere_volume(p.radius) * density;
         if !m.is_finite() {
             bail!(
                 "{}:{}: particle {i}: column 7 (radius): {:e} is too large to coarse-grain: its \
