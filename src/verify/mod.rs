@@ -379,8 +379,11 @@ pub fn table(rows: &[Row]) -> String {
     for r in rows {
         if is_error(r) {
             s.push_str(&format!(
-                "{:<56} {:<48} {:>55}  ERROR\n",
-                r.case, r.quantity, ""
+                "{:<56} {:<48} {:>55}  {}\n",
+                r.case,
+                r.quantity,
+                "",
+                result(r)
             ));
             for line in r.measured_text.lines() {
                 s.push_str(&format!("    {line}\n"));
