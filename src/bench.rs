@@ -215,7 +215,7 @@ pub fn run_peer(
 ) -> anyhow::Result<f64> {
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     let script = peer.input_script(case, &data.display().to_string(), steps, None)?;
-    peer.run(np, dir, &script)
+    peer.run(&crate::peers::Run { dir, np }, &script)
 }
 
 /// One round: every configuration of `out` once, in order, `steps` steps from `state`; each
@@ -706,11 +706,7 @@ pub fn processes(c: &Config) -> Option<usize> {
     match c {
         Config::Verdem { copies: 1, .. } => Some(1),
         Config::Verdem { .. } => None,
-        Config::Peer { peer, np } => Some(if peer.command_line(*np).starts_with("mpirun") {
-            *np
-        } else {
-            1
-        }),
+        Config::Peer { peer, np } => Some(if peer.launch(*np).by_mpirun() { *np } else { 1 }),
     }
 }
 

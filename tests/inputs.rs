@@ -1541,7 +1541,10 @@ proptest! {
         arbitrary_text(Vec::new())
     ]) {
         let yade = verdem::peers::by_name("yade").unwrap();
-        named_file("save.0.txt", &b, |p| yade.read_frame(p.parent().unwrap(), 0))?;
+        named_file("save.0.txt", &b, |p| {
+            let run = verdem::peers::Run { dir: p.parent().unwrap(), np: 1 };
+            yade.read_frame(&run, verdem::peers::Save { index: 0, step: 0 })
+        })?;
     }
 
     #[test]
@@ -1553,7 +1556,10 @@ proptest! {
         let s = SMALL_SNAPSHOT.with(Clone::clone);
         for peer in ["yade", "lammps", "liggghts"] {
             let peer = verdem::peers::by_name(peer).unwrap();
-            named_file("contacts.0.txt", &b, |p| peer.read_contacts(p.parent().unwrap(), 0, &s))?;
+            named_file("contacts.0.txt", &b, |p| {
+                let run = verdem::peers::Run { dir: p.parent().unwrap(), np: 1 };
+                peer.read_contacts(&run, verdem::peers::Save { index: 0, step: 0 }, &s)
+            })?;
         }
     }
 

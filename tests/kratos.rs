@@ -5,7 +5,7 @@
 
 mod common;
 
-use verdem::peers::{self, Peer};
+use verdem::peers::{self, Peer, Run, Save};
 
 fn kratos() -> &'static dyn Peer {
     peers::by_name("kratos").unwrap()
@@ -76,20 +76,25 @@ fn kratos_runs_the_shear_case_from_a_state() {
         // 480 of the 3480 spheres are walls: the median sphere is not one, so check them apart
         assert!(s.dx.max < 1e-3 && s.dx.max > 1e-9, "{s:?}");
     }
-    let save = |k: u64| kratos().read_frame(&dir.path().join("kratos"), k).unwrap();
+    let run_dir = dir.path().join("kratos");
+    let run = Run {
+        dir: &run_dir,
+        np: 1,
+    };
+    let save = |k: u64| kratos().read_frame(&run, Save::every(100, k)).unwrap();
     let snap = common::engine(&case, Some(&state), Default::default()).snapshot();
     let own = verdem::io::mercury::read_data(&dir.path().join("verdem/shear_flow_quick.data.0002"))
         .unwrap();
-    let theirs = save(200);
+    let theirs = save(2);
     for a in 0..480 {
         let d = snap.domain.min_image(own.rows[a].x - theirs.x[a]);
         assert!(d.norm() < 1e-12, "wall sphere {a}: {d:?}");
     }
     let e = kratos()
-        .read_contacts(&dir.path().join("kratos"), 200, &snap)
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("no per-contact forces"), "{e}");
+        .read_contacts(&run, Save::every(100, 2), &snap)
+        .unwrap_err();
+    assert!(peers::lacks(&e).is_some(), "{e:#}");
+    assert!(e.to_string().contains("no per-contact forces"), "{e}");
 }
 
 /// A timing run without saves on 1 and 2 OpenMP threads: Kratos reports the threads it was
@@ -109,7 +114,13 @@ fn kratos_times_its_loop_on_the_threads_it_is_given() {
     let script = kratos().input_script(&case, &state, 20, None).unwrap();
     for np in [1, 2] {
         let seconds = kratos()
-            .run(np, dir.path(), &script)
+            .run(
+                &Run {
+                    dir: dir.path(),
+                    np,
+                },
+                &script,
+            )
             .unwrap_or_else(|e| panic!("{np} thread(s): {e:#}"));
         assert!(seconds > 0.0 && seconds.is_finite(), "{seconds}");
         let log = std::fs::read_to_string(dir.path().join("kratos.log")).unwrap();
@@ -171,10 +182,16 @@ fn kratos_tangential_dashpot_is_tied_to_the_normal_one() {
     let state = kratos()
         .write_state(&e.snapshot(), 1.0, dir.path(), "pair")
         .unwrap();
+    let run = Run {
+        dir: dir.path(),
+        np: 1,
+    };
     kratos()
-        .run(1, dir.path(), &kratos().collision_script(&timed, &state, 1))
+        .run(&run, &kratos().collision_script(&timed, &state, 1).unwrap())
         .unwrap_or_else(|e| panic!("{e:#}"));
-    let save = kratos().read_frame(dir.path(), 0).unwrap();
+    let save = kratos()
+        .read_frame(&run, Save { index: 0, step: 0 })
+        .unwrap();
     let (m, dt) = (timed.particle_mass(), timed.dt());
     let f = (save.v[0] - Vec3::new(0.0, v, 0.0)) * (2.0 * m / dt);
     let c = &timed.contact;

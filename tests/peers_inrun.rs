@@ -9,7 +9,7 @@ mod common;
 use verdem::analysis::cg::{self, CgOptions, Series};
 use verdem::analysis::inrun::Inrun;
 use verdem::case::Case;
-use verdem::peers::{self, cross::cross_inrun};
+use verdem::peers::{self, cross::cross_inrun, Run, Save};
 
 /// The benchmark's case, from the full run's final state.
 fn steady() -> (Case, std::path::PathBuf) {
@@ -121,7 +121,11 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
         let n = lines.len();
         std::fs::write(&walls_txt, lines[..n - 1].join("\n") + "\n").unwrap();
         let profiles = |o: &CgOptions| {
-            peers::inrun::peer_profiles(peer, &peer_dir, o, &template, sampling, case.dt())
+            let run = Run {
+                dir: &peer_dir,
+                np: 1,
+            };
+            peers::inrun::peer_profiles(peer, &run, o, &template, sampling, case.dt())
                 .map(|_| ())
                 .unwrap_err()
                 .to_string()
@@ -160,13 +164,13 @@ fn a_peers_inrun_profiles_are_the_coarse_graining_of_its_saves_at_the_same_steps
         let count = (n - 1).to_string();
         lines[3] = &count;
         std::fs::write(&positions, lines.join("\n") + "\n").unwrap();
+        let run_dir = out.join(peer.binary());
+        let run = Run {
+            dir: &run_dir,
+            np: 1,
+        };
         let e = peer
-            .read_sample(
-                &out.join(peer.binary()),
-                400,
-                &snapshot(&case, &state),
-                false,
-            )
+            .read_sample(&run, Save::every(50, 8), &snapshot(&case, &state), false)
             .unwrap_err()
             .to_string();
         assert!(
@@ -230,8 +234,13 @@ fn a_peers_wall_forces_are_every_steps_mean_also_when_every_step_is_sampled() {
         let sampling = peers::inrun::sampling(300, 1, 150);
         let mut sampled = Inrun::new(&o, &template.domain, sampling).unwrap();
         for step in 1..=300 {
+            let run_dir = out.join(peer.binary());
+            let run = Run {
+                dir: &run_dir,
+                np: 1,
+            };
             let s = peer
-                .read_sample(&out.join(peer.binary()), step, &template, false)
+                .read_sample(&run, Save::every(1, step), &template, false)
                 .unwrap_or_else(|e| panic!("{name}: step {step}: {e:#}"));
             sampled.sample(&s, step % 150 == 0);
         }

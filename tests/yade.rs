@@ -6,7 +6,7 @@
 mod common;
 
 use verdem::case::{Case, Tangential};
-use verdem::peers::{self, Peer};
+use verdem::peers::{self, Peer, Run, Save};
 
 fn yade() -> &'static dyn Peer {
     peers::by_name("yade").unwrap()
@@ -267,8 +267,12 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
     std::fs::write(&positions, lines.join("\n") + "\n").unwrap();
     let mut template = template;
     template.contacts.clear();
+    let yade_run = Run {
+        dir: &yade_dir,
+        np: 1,
+    };
     let e = yade()
-        .read_sample(&yade_dir, 400, &template, false)
+        .read_sample(&yade_run, Save::every(k, 400 / k), &template, false)
         .unwrap_err()
         .to_string();
     assert!(
@@ -282,7 +286,7 @@ fn yades_inrun_dumps_give_its_profiles_and_wall_forces() {
     std::fs::write(&walls_txt, kept.join("\n") + "\n").unwrap();
     let e = peers::inrun::peer_profiles(
         yade(),
-        &yade_dir,
+        &yade_run,
         &verdem::analysis::cg::CgOptions::for_case(&case),
         &template,
         peers::inrun::sampling(4800, k, kp),
@@ -334,8 +338,14 @@ fn yades_wall_forces_every_step_are_its_sampled_ones_when_every_step_is_sampled(
     let o = verdem::analysis::cg::CgOptions::for_case(&case);
     let mut sampled = Inrun::new(&o, &template.domain, sampling).unwrap();
     for step in 1..=300 {
+        let dir = out.join("yade");
         let s = yade()
-            .read_sample(&out.join("yade"), step, &template, false)
+            .read_sample(
+                &Run { dir: &dir, np: 1 },
+                Save::every(1, step),
+                &template,
+                false,
+            )
             .unwrap_or_else(|e| panic!("step {step}: {e:#}"));
         sampled.sample(&s, step % 150 == 0);
     }

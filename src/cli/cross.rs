@@ -12,8 +12,10 @@ use super::Finished;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The peer, by name (`verdem peers` lists them: lammps, liggghts, yade, kratos).
-    #[arg(value_parser = verdem::peers::by_name)]
+    #[arg(
+        value_parser = verdem::peers::by_name,
+        help = format!("The peer, by name (`verdem peers` lists them: {})", verdem::peers::listed())
+    )]
     peer: &'static dyn Peer,
     /// Case file (default: cases/shear_flow_quick.toml).
     #[arg(default_value = "cases/shear_flow_quick.toml")]

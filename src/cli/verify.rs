@@ -23,10 +23,16 @@ pub struct Args {
     /// are not run.
     #[arg(long)]
     only: Option<String>,
-    /// Also run the binary collisions in these installed peers (lammps, liggghts, yade,
-    /// kratos), against
-    /// the same closed forms.
-    #[arg(long, value_parser = peers::by_name, value_delimiter = ',')]
+    #[arg(
+        long,
+        value_parser = peers::by_name,
+        value_delimiter = ',',
+        help = format!(
+            "Also run the binary collisions in these installed peers ({}), against the same \
+             closed forms",
+            peers::listed()
+        )
+    )]
     peers: Vec<&'static dyn Peer>,
     /// Run the prescribed-motion cases (objectivity, ratchet, tangential histories) through
     /// this program instead of verdem's laws: it is run as `CMD CASE.toml MOTION.csv --out
@@ -89,17 +95,23 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         None => verify::run(&verify::select(verify::entries(&a.cases), only)?)?,
     };
     let collision = Case::load(&a.cases.join("binary_collision.toml"))?;
+    let mut chosen = Vec::new();
     for &peer in &a.peers {
         let dir = a.out.join(peer.binary());
         rows.extend(peers::collision::rows(peer, &collision, &dir)?);
+        match peer.motion() {
+            Ok(libraries) => chosen.extend_from_slice(libraries),
+            Err(why) => rows.push(verify::lacking_row(
+                &format!("{} prescribed motion", peer.binary()),
+                &format!("{}: {why}", peer.name()),
+            )),
+        }
     }
     // The prescribed-motion cases in the peers' libraries, held to verdem's re-implementation of
     // each convention where it has a known defect. After every binary has run: an MPI library
     // started in this process leaves an environment that MPI programs started from it inherit
     // and fail on.
-    let libraries = MotionPeer::ALL
-        .into_iter()
-        .filter(|m| a.peers.iter().any(|p| m.belongs_to(p.name())));
+    let libraries = MotionPeer::ALL.into_iter().filter(|m| chosen.contains(m));
     for library in libraries {
         let subject = Subject::code(&library, Some(library.convention()));
         let entries: Vec<_> = verify::code_entries(&a.cases, &subject)
@@ -118,14 +130,20 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let passed = rows.iter().filter(|r| r.passed()).count();
     let failed = verify::failures(&rows);
     let errors = rows.iter().filter(|r| verify::is_error(r)).count();
+    let lacking = rows.iter().filter(|r| verify::is_lacking(r)).count();
     println!(
-        "{passed} passed, {failed} failed{}, {} known defects of peer conventions (FAIL*)",
+        "{passed} passed, {failed} failed{}, {} known defects of peer conventions (FAIL*){}",
         if errors > 0 {
             format!(" ({errors} could not be measured: ERROR)")
         } else {
             String::new()
         },
-        rows.len() - passed - failed
+        rows.len() - passed - failed - lacking,
+        if lacking > 0 {
+            format!(", {lacking} not run: what a peer lacks (info)")
+        } else {
+            String::new()
+        }
     );
     a.reports
         .write("verdem verify", &rows, |r| verify::result(r).into())?;

@@ -1,16 +1,17 @@
 //! Binary collisions run in a peer: the same two spheres, law and time step as verdem's
 //! verification case, the restitution coefficient read from the peer's dump after the contact
 //! and, where the peer records it, how long the normal force acted. A peer whose normal force
-//! is clipped at zero ([`Peer::clips_normal_force`]) is held to the clipped closed forms.
+//! is clipped at zero ([`Peer::clips_normal_force`]) is held to the clipped closed forms; a
+//! peer without a collision run ([`Peer::collision_script`]) gets one `info` row saying so.
 
 use std::path::Path;
 
 use anyhow::Context;
 
-use super::Peer;
+use super::{lacks, Peer, Run, Save};
 use crate::case::Case;
 use crate::verify::collision::{closed_form, head_on, impact_setup};
-use crate::verify::{row, Row};
+use crate::verify::{lacking_row, row, Row};
 
 /// What a peer's head-on collision gave.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,7 +39,8 @@ pub fn restitution(
 }
 
 /// A head-on collision at speed `v0` (onto a fixed sphere when `wall`) in `peer` under `case`'s
-/// law at its dt, run in `dir`.
+/// law at its dt, run in `dir` on one process; a [`super::Lacks`] error when the peer has no
+/// collision run.
 pub fn collide(
     peer: &dyn Peer,
     case: &Case,
@@ -57,8 +59,16 @@ pub fn collide(
     // the contact with a fixed sphere lasts tc_fw = √2·tc_ff at most; then free flight
     let tc_fw = closed_form(&timed, timed.particle_mass()).tc;
     let steps = (tc_fw / dt * 1.5).ceil() as u64 + 5;
-    peer.run(1, dir, &peer.collision_script(&timed, &data, steps))?;
-    let end = peer.read_frame(dir, steps)?;
+    let script = peer.collision_script(&timed, &data, steps)?;
+    let run = Run { dir, np: 1 };
+    peer.run(&run, &script)?;
+    let end = peer.read_frame(
+        &run,
+        Save {
+            index: 1,
+            step: steps,
+        },
+    )?;
     Ok(Outcome {
         e: (end.v[1] - end.v[0]).x / v0,
         duration: peer.collision_duration(dir).transpose()?,
@@ -68,7 +78,8 @@ pub fn collide(
 
 /// Rows of the binary collisions in `peer` against the closed forms, both partners, speeds
 /// 1e-3 … 10, at the case's dt: the restitution, and the contact time where the peer records
-/// it (known to one step, as verdem's own rows).
+/// it (known to one step, as verdem's own rows). A peer without a collision run gets one
+/// [`lacking_row`] instead.
 pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>> {
     let m = case.particle_mass();
     let per_tc = case.run.steps_per_collision.unwrap_or(50.0);
@@ -89,7 +100,16 @@ pub fn rows(peer: &dyn Peer, case: &Case, dir: &Path) -> anyhow::Result<Vec<Row>
         };
         for v0 in [1e-3, 1e-1, 1.0, 10.0] {
             let sub = dir.join(format!("{label}-{v0}"));
-            let got = collide(peer, case, v0, wall, &sub)?;
+            let got = match collide(peer, case, v0, wall, &sub) {
+                Ok(got) => got,
+                Err(e) => match lacks(&e) {
+                    Some(why) => {
+                        let name = format!("{} binary collisions", peer.binary());
+                        return Ok(vec![lacking_row(&name, &format!("{}: {why}", peer.name()))]);
+                    }
+                    None => return Err(e),
+                },
+            };
             let name = format!("{} {label} v0={v0} dt=tc/{per_tc}", peer.binary());
             rows.push(row(&name, &format!("restitution e{kind}"), e, got.e, 2e-3));
             if let Some(duration) = got.duration {

@@ -9,7 +9,8 @@
 //! written as MercuryCG `.data`/`.fstat` saves (the peer's contact forces from its contact
 //! dumps), coarse-grained by verdem into `PEER.profiles.csv` and `verdem.profiles.csv`,
 //! overlaid in `profiles.png`, and compared profile by profile (χ²/dof). A peer without contact
-//! forces (Kratos DEM, [`Peer::has_contact_forces`]) is compared particle by particle only; its
+//! forces (Kratos DEM: [`Peer::read_contacts`] says it lacks them) is compared particle by
+//! particle only; its
 //! normal force is clipped, so verdem's is too ([`Peer::clips_normal_force`]).
 //!
 //! With in-run averaging ([`super::inrun`]) the peer also dumps its samples every K and KP
@@ -23,7 +24,7 @@ use std::path::Path;
 use anyhow::{ensure, Context};
 
 use super::inrun as peer_inrun;
-use super::Peer;
+use super::{lacks, Peer, Run, Save};
 use crate::analysis::cg::{self, table::Table};
 use crate::analysis::difference::{differences, Difference};
 use crate::analysis::inrun::{self, InrunResult, Sampling};
@@ -130,7 +131,7 @@ pub struct Report {
     pub saves: Vec<SaveDiff>,
     /// χ²/dof of each profile of [`cg::FIELDS`] of the peer's series against verdem's (all
     /// saves coarse-grained, block standard errors); none when the peer gives no contact
-    /// forces ([`Peer::has_contact_forces`]), without which its stresses are unknown.
+    /// forces ([`Peer::read_contacts`] lacks them), without which its stresses are unknown.
     pub profiles_chi2: Option<[f64; 5]>,
     /// The in-run profiles, when asked for.
     pub inrun: Option<InrunReport>,
@@ -283,7 +284,8 @@ pub fn cross_inrun(
             .inrun_script(&case, &data, steps, every, s.every, s.particle_every)
             .with_context(|| format!("{} has no in-run dumps", peer.name()))??,
     };
-    peer.run(np, &peer_dir, &script)?;
+    let run = Run { dir: &peer_dir, np };
+    peer.run(&run, &script)?;
     let o = cg::CgOptions::for_case(&case);
     let mut own_inrun = sampling
         .map(|s| {
@@ -291,6 +293,7 @@ pub fn cross_inrun(
         })
         .transpose()?;
     let mut saves = Vec::new();
+    let mut with_forces = true;
     for k in 0..=steps / every {
         if k > 0 {
             match own_inrun.as_mut() {
@@ -303,7 +306,8 @@ pub fn cross_inrun(
         atomic::write(&own_dir.join(&name), data_text(&own).as_bytes())?;
         let fstat = format!("{}.fstat.{k:04}", case.name);
         atomic::write(&own_dir.join(&fstat), fstat_text(&own).as_bytes())?;
-        let frame = peer.read_frame(&peer_dir, k * every)?;
+        let save = Save::every(every, k);
+        let frame = peer.read_frame(&run, save)?;
         ensure!(
             frame.x.len() == own.particles.len(),
             "{}: {} atoms, the state has {}",
@@ -318,9 +322,15 @@ pub fn cross_inrun(
         theirs.particles.w = frame.w;
         theirs.particles.radius = frame.radius;
         atomic::write(&peer_dir.join(&name), data_text(&theirs).as_bytes())?;
-        if peer.has_contact_forces() {
-            theirs.contacts = peer.read_contacts(&peer_dir, k * every, &theirs)?;
-            atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
+        if with_forces {
+            match peer.read_contacts(&run, save, &theirs) {
+                Ok(contacts) => {
+                    theirs.contacts = contacts;
+                    atomic::write(&peer_dir.join(&fstat), fstat_text(&theirs).as_bytes())?;
+                }
+                Err(e) if lacks(&e).is_some() => with_forces = false,
+                Err(e) => return Err(e),
+            }
         }
         let (a, b) = (&own.particles, &theirs.particles);
         let n = a.len();
@@ -335,7 +345,7 @@ pub fn cross_inrun(
     let inrun = match (sampling, own_inrun) {
         (Some(s), Some(acc)) => Some(InrunReport {
             sampling: s,
-            peer: peer_profiles(peer, &peer_dir, &o, &template, s, case.dt())?,
+            peer: peer_profiles(peer, &run, &o, &template, s, case.dt())?,
             verdem_as_peer: acc.result().context("verdem: no in-run sample")?,
             verdem: own_profiles(own_case, state, np, s)?,
             own_convention: own_case.contact.tangential,
@@ -359,7 +369,7 @@ pub fn cross_inrun(
     let own = cg::coarse_grain(&series(&own_dir)?, &o)?;
     let own_table = Table::of(&own);
     atomic::write(&out.join("verdem.profiles.csv"), own_table.csv().as_bytes())?;
-    let profiles_chi2 = if peer.has_contact_forces() {
+    let profiles_chi2 = if with_forces {
         let theirs = cg::coarse_grain(&series(&peer_dir)?, &o)?;
         let their_table = Table::of(&theirs);
         atomic::write(
@@ -386,17 +396,18 @@ pub fn cross_inrun(
     Ok(report)
 }
 
-/// The peer's in-run profiles from its dumps in `dir` ([`peer_inrun::peer_profiles`]); its
-/// particle dumps are removed once read (0.7 MB each on the benchmark).
+/// The peer's in-run profiles from its dumps in `run`'s folder ([`peer_inrun::peer_profiles`]);
+/// its particle dumps are removed once read (0.7 MB each on the benchmark).
 fn peer_profiles(
     peer: &dyn Peer,
-    dir: &Path,
+    run: &Run,
     o: &cg::CgOptions,
     template: &crate::state::Snapshot,
     s: Sampling,
     dt: f64,
 ) -> anyhow::Result<InrunResult> {
-    let r = peer_inrun::peer_profiles(peer, dir, o, template, s, dt)?;
+    let r = peer_inrun::peer_profiles(peer, run, o, template, s, dt)?;
+    let dir = run.dir;
     for entry in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
         let path = entry?.path();
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use anyhow::{ensure, Context};
 
-use super::Peer;
+use super::{Peer, Run, Save};
 use crate::analysis::cg::CgOptions;
 use crate::analysis::difference::Difference;
 use crate::analysis::inrun::{Inrun, InrunResult, Sampling};
@@ -125,7 +125,7 @@ pub fn sampling(steps: u64, every: u64, particle_every: u64) -> Sampling {
     }
 }
 
-/// The in-run profiles of `peer`'s run in `dir` (made by [`Peer::inrun_script`] with the
+/// The in-run profiles of `peer`'s run `run` (made by [`Peer::inrun_script`] with the
 /// intervals of `sampling`): its sample at every sampling step, read as a state of `template`
 /// ([`Peer::read_sample`]), added to an accumulator of the coarse-graining `o`, with the walls'
 /// every-step means of its [`WALLS_FILE`] when the peer writes one ([`Peer::writes_wall_means`]) (else the wall forces are
@@ -134,7 +134,7 @@ pub fn sampling(steps: u64, every: u64, particle_every: u64) -> Sampling {
 /// refused, naming it.
 pub fn peer_profiles(
     peer: &dyn Peer,
-    dir: &Path,
+    run: &Run,
     o: &CgOptions,
     template: &Snapshot,
     sampling: Sampling,
@@ -142,14 +142,19 @@ pub fn peer_profiles(
 ) -> anyhow::Result<InrunResult> {
     let mut acc = Inrun::new(o, &template.domain, sampling)?.with_reference_tau(dt);
     if peer.writes_wall_means() {
-        let file = dir.join(WALLS_FILE);
+        let file = run.dir.join(WALLS_FILE);
         book_wall_means(&mut acc, &file, &read_wall_means(&file, sampling.every)?)?;
     }
     let first = (sampling.from / sampling.every + 1) * sampling.every;
     for step in (first..=sampling.to).step_by(sampling.every as usize) {
         let particles = step.is_multiple_of(sampling.particle_every);
         let s = peer
-            .read_sample(dir, step, template, particles)
+            .read_sample(
+                run,
+                Save::every(sampling.every, step / sampling.every),
+                template,
+                particles,
+            )
             .with_context(|| format!("{}: in-run sample at step {step}", peer.name()))?;
         acc.sample(&s, particles);
     }

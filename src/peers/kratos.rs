@@ -20,7 +20,7 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, ensure, Context};
 
 use super::lammps_family::dump;
-use super::{Frame, Installed, Peer};
+use super::{Frame, Installed, Lacks, Launch, Peer, Run, Save};
 use crate::case::{Case, Tangential};
 use crate::child::{self, OnParentDeath};
 use crate::io::atomic;
@@ -306,17 +306,28 @@ impl Peer for Kratos {
 
     /// Saves at the start and at step `steps`; the driver also counts the steps at whose end
     /// the two spheres overlap ([`Peer::contact_steps`]).
-    fn collision_script(&self, case: &Case, state: &str, steps: u64) -> String {
-        settings(case, state, steps, steps, true)
+    fn collision_script(&self, case: &Case, state: &str, steps: u64) -> Result<String, Lacks> {
+        Ok(settings(case, state, steps, steps, true))
     }
 
     /// Runs the driver with [`python`] in `dir` with `np` OpenMP threads (Kratos' MPI build
     /// needs a partitioned model; verdem runs its shared-memory one); Kratos' output goes to
     /// `kratos.log` there.
-    fn run(&self, np: usize, dir: &Path, input: &str) -> anyhow::Result<f64> {
-        let dir = &dir
+    fn launch(&self, np: usize) -> Launch {
+        Launch {
+            env: vec![("OMP_NUM_THREADS", np.to_string())],
+            program: python().program,
+            args: vec![DRIVER_NAME.into()],
+            reads: Some(SETTINGS),
+            log: Some(LOG),
+        }
+    }
+
+    fn run(&self, run: &Run, input: &str) -> anyhow::Result<f64> {
+        let dir = &run
+            .dir
             .canonicalize()
-            .with_context(|| dir.display().to_string())?;
+            .with_context(|| run.dir.display().to_string())?;
         atomic::write(&dir.join(SETTINGS), input.as_bytes())?;
         atomic::write(&dir.join(DRIVER_NAME), DRIVER.as_bytes())?;
         let log_path = dir.join(LOG);
@@ -324,10 +335,8 @@ impl Peer for Kratos {
             std::fs::File::create(&log_path).with_context(|| log_path.display().to_string())?;
         let py = python();
         let status = child::status(
-            Command::new(&py.program)
-                .arg(DRIVER_NAME)
-                .current_dir(dir)
-                .env("OMP_NUM_THREADS", np.to_string())
+            self.launch(run.np)
+                .command(dir)
                 .stdin(Stdio::null())
                 .stdout(log.try_clone()?)
                 .stderr(log),
@@ -361,17 +370,12 @@ impl Peer for Kratos {
             .with_context(|| format!("{}: no '{LOOP_LINE}' line", log_path.display()))
     }
 
-    fn command_line(&self, np: usize) -> String {
-        format!(
-            "OMP_NUM_THREADS={np} {} {DRIVER_NAME} (reads {SETTINGS}) > {LOG} 2>&1",
-            python().program.display()
-        )
-    }
-
-    /// `dump.STEP.txt` in `dir`. Kratos' symplectic Euler step keeps the velocity that moved
+    /// `dump.STEP.txt` in the run folder. Kratos' symplectic Euler step keeps the velocity that moved
     /// the sphere over the last step: verdem's half-step velocity v(t − dt/2), not v(t).
-    fn read_frame(&self, dir: &Path, step: u64) -> anyhow::Result<Frame> {
-        Ok(dump::read(&dir.join(format!("dump.{step}.txt")))?)
+    fn read_frame(&self, run: &Run, save: Save) -> anyhow::Result<Frame> {
+        Ok(dump::read(
+            &run.dir.join(format!("dump.{}.txt", save.step)),
+        )?)
     }
 
     /// Kratos DEM keeps a sphere's contact forces inside the sphere's element and gives
@@ -379,19 +383,16 @@ impl Peer for Kratos {
     /// bonded (continuum) strategies only. So there are none to read.
     fn read_contacts(
         &self,
-        _dir: &Path,
-        _step: u64,
+        _run: &Run,
+        _save: Save,
         _s: &Snapshot,
     ) -> anyhow::Result<Vec<Contact>> {
-        bail!(
+        Err(Lacks(
             "Kratos DEM 10.4.4 gives no per-contact forces: the sphere strategy keeps them inside \
              each sphere's element, not reachable from Python, and its contact mesh \
-             (ContactMeshOption) is built for bonded (continuum) strategies only"
+             (ContactMeshOption) is built for bonded (continuum) strategies only",
         )
-    }
-
-    fn has_contact_forces(&self) -> bool {
-        false
+        .into())
     }
 
     /// About 100 times slower than LAMMPS here: the default rounds of `verdem bench` would take

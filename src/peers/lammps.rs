@@ -3,6 +3,7 @@
 //! units.
 
 use super::lammps_family::{boundary, neighbor, Dialect, GROUPS};
+use super::motion::MotionPeer;
 use crate::case::{Case, Tangential};
 use crate::state::Snapshot;
 use crate::Vec3;
@@ -15,6 +16,7 @@ impl Dialect for Lammps {
     const BINARY: &'static str = "lmp";
     const CONVENTION: Tangential = Tangential::LammpsGranular;
     const CONTACT_COLUMNS: usize = 6;
+    const MOTION: &'static [MotionPeer] = &[MotionPeer::Lammps, MotionPeer::LammpsHookeHistory];
     /// `fix ave/time … format " %.17g"` (its default is `%g` after a space).
     const WALLS_FORMAT: Option<&'static str> = Some("\" %.17g\"");
 

@@ -2,6 +2,7 @@
 //! tangential history absolute_damping on`, in SI units; coefficients per pair of atom types.
 
 use super::lammps_family::{boundary, neighbor, Dialect, DUMP_COLUMNS, GROUPS};
+use super::motion::MotionPeer;
 use crate::case::{Case, Tangential};
 use crate::state::Snapshot;
 use crate::Vec3;
@@ -14,6 +15,7 @@ impl Dialect for Liggghts {
     const BINARY: &'static str = "liggghts";
     const CONVENTION: Tangential = Tangential::Liggghts;
     const CONTACT_COLUMNS: usize = 5;
+    const MOTION: &'static [MotionPeer] = &[MotionPeer::Liggghts];
     /// LIGGGHTS 3.8 refuses `fix ave/time`'s `format` keyword ("Illegal fix ave/time
     /// command"): its means keep the default `%g`, 6 significant digits.
     const WALLS_FORMAT: Option<&'static str> = None;

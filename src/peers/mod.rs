@@ -24,8 +24,10 @@ pub mod liggghts;
 pub mod motion;
 pub mod yade;
 
+use self::motion::MotionPeer;
 use crate::case::{Case, Scene, Tangential};
 use crate::child::{self, OnParentDeath};
+use crate::io::mercury;
 use crate::state::{Contact, PairForce, Snapshot};
 use crate::Vec3;
 
@@ -38,7 +40,10 @@ static ALL: &[&dyn Peer] = &[
 ];
 
 /// A peer code: how it is installed and started, how it reads verdem's cases and states, and
-/// how its saves are read back.
+/// how its saves are read back. What a code may lack (a two-sphere collision run, per-contact
+/// forces, a library driven through a prescribed motion, in-run dumps) has a default that says
+/// it lacks it ([`Lacks`]); `verdem verify --peers` reports that as an `info` row and
+/// `verdem cross` compares what remains.
 pub trait Peer: Sync {
     /// Its name on the command line and in tables, lower case (`lammps`).
     fn name(&self) -> &'static str;
@@ -54,13 +59,21 @@ pub trait Peer: Sync {
     fn convention(&self) -> Tangential;
 
     /// Whether its set-up force evaluation (before the first step) advances the tangential
-    /// history, as verdem's does by default.
-    fn setup_advances_history(&self) -> bool;
+    /// history, as verdem's does by default (the default: yes).
+    fn setup_advances_history(&self) -> bool {
+        true
+    }
 
     /// Whether its normal force is clipped at zero (no attractive tail at the end of a
-    /// contact), as verdem's `clip_normal`.
+    /// contact), as verdem's `clip_normal` (the default: no).
     fn clips_normal_force(&self) -> bool {
         false
+    }
+
+    /// Whether `verdem bench` times it when no `--peers` are given (the default: yes); no for
+    /// a peer so slow that the default rounds would take hours (it is timed when named).
+    fn timed_by_default(&self) -> bool {
+        true
     }
 
     /// Writes the state `s` (spheres of mass density `density`) in its own format into `dir`
@@ -75,8 +88,9 @@ pub trait Peer: Sync {
 
     /// An input script running `steps` steps of the bumpy-shear `case` from the state file
     /// `state` (a [`Peer::write_state`] name or path): with `dump_every` `None` no file output
-    /// (for timing), else a save of particles and contacts every so many steps, step 0 included,
-    /// that [`Peer::read_frame`] and [`Peer::read_contacts`] read.
+    /// (for timing), else a save of particles and contacts every so many steps, step 0 included
+    /// (save index k at step k·`dump_every`), that [`Peer::read_frame`] and
+    /// [`Peer::read_contacts`] read.
     fn input_script(
         &self,
         case: &Case,
@@ -86,33 +100,62 @@ pub trait Peer: Sync {
     ) -> anyhow::Result<String>;
 
     /// An input script running `steps` steps of a two-sphere `case` from `state` (a fixed
-    /// sphere held still, with infinite mass), saving at the start and at step `steps`.
-    fn collision_script(&self, case: &Case, state: &str, steps: u64) -> String;
+    /// sphere held still, with infinite mass), saving at the start (save 0) and at step `steps`
+    /// (save 1); the default: it has no such run.
+    fn collision_script(&self, _case: &Case, _state: &str, _steps: u64) -> Result<String, Lacks> {
+        Err(Lacks("it has no two-sphere collision run"))
+    }
 
     /// How long the normal force of the collision run in `dir` ([`Peer::collision_script`])
-    /// was positive (time), if the peer records it.
+    /// was positive (time), if the peer records it (the default: it does not).
     fn collision_duration(&self, _dir: &Path) -> Option<anyhow::Result<f64>> {
         None
     }
 
-    /// Runs `input` on `np` processes in `dir` (where its files are written); returns the
-    /// seconds of its own time loop, without set-up and file reading.
-    fn run(&self, np: usize, dir: &Path, input: &str) -> anyhow::Result<f64>;
+    /// The number of steps the pair of a collision run in `dir` ([`Peer::collision_script`])
+    /// overlapped at the end of a step, where the peer records it (the default: it does not).
+    fn contact_steps(&self, _dir: &Path) -> anyhow::Result<Option<u64>> {
+        Ok(None)
+    }
 
-    /// How [`Peer::run`] starts it on `np` processes, as a command line (for provenance).
-    fn command_line(&self, np: usize) -> String;
+    /// How [`Peer::run`] starts it on `np` processes or threads in its run folder; its text
+    /// ([`Launch`]'s `Display`) is the command line of provenance.
+    fn launch(&self, np: usize) -> Launch;
 
-    /// Its particles at save `step` of a run in `dir`, in id order.
-    fn read_frame(&self, dir: &Path, step: u64) -> anyhow::Result<Frame>;
+    /// Runs `input` as [`Peer::launch`] on `run.np` processes or threads in `run.dir` (where
+    /// its files are written); returns the seconds of its own time loop, without set-up and
+    /// file reading.
+    fn run(&self, run: &Run, input: &str) -> anyhow::Result<f64>;
 
-    /// Its contacts at save `step` of a run in `dir`, as verdem contacts of the state `s` (its
-    /// particles at that save): P the lower index, the force on P, sorted by `(p, i)`.
-    fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>>;
+    /// Its particles at `save` of a run, in id order.
+    fn read_frame(&self, run: &Run, save: Save) -> anyhow::Result<Frame>;
+
+    /// Its contacts at `save` of a run, as verdem contacts of the state `s` (its particles at
+    /// that save): P the lower index, the force on P, sorted by `(p, i)` ([`contact_of`];
+    /// [`mercury_contacts`] for a MercuryCG `.fstat` save). The default: a [`Lacks`] error,
+    /// the peer gives no per-contact forces (a cross-run then compares particles only).
+    fn read_contacts(
+        &self,
+        _run: &Run,
+        _save: Save,
+        _s: &Snapshot,
+    ) -> anyhow::Result<Vec<Contact>> {
+        Err(Lacks("it gives no per-contact forces").into())
+    }
+
+    /// The libraries of its contact law that verdem drives through a prescribed motion in
+    /// process (`verdem verify --peers` runs the prescribed-motion cases through them); the
+    /// default: none.
+    fn motion(&self) -> Result<&'static [MotionPeer], Lacks> {
+        Err(Lacks(
+            "verdem drives no library of its contact law through a prescribed motion",
+        ))
+    }
 
     /// An input script as [`Peer::input_script`] with a save every `every` steps, that also
     /// dumps what in-run averaging samples ([`Peer::read_sample`]): the contact forces and the
     /// positions of the spheres in contact every `contact_every` steps, all particles every
-    /// `particle_every` steps; `None` when the peer has no such dumps.
+    /// `particle_every` steps; `None` (the default) when the peer has no such dumps.
     fn inrun_script(
         &self,
         _case: &Case,
@@ -125,15 +168,15 @@ pub trait Peer: Sync {
         None
     }
 
-    /// The in-run sample at `step` of a run of [`Peer::inrun_script`] in `dir`, as a snapshot
-    /// of `template`'s particles (ids, motion, domain) at that step: the spheres in contact at
-    /// their dumped positions with the peer's contacts (as [`Peer::read_contacts`]), and, when
-    /// `particles`, every particle's radius, position, velocity and spin; the other particles
-    /// keep `template`'s values.
+    /// The in-run sample at `save` (index k at step k·`contact_every`) of a run of
+    /// [`Peer::inrun_script`], as a snapshot of `template`'s particles (ids, motion, domain) at
+    /// that step: the spheres in contact at their dumped positions with the peer's contacts (as
+    /// [`Peer::read_contacts`]), and, when `particles`, every particle's radius, position,
+    /// velocity and spin; the other particles keep `template`'s values.
     fn read_sample(
         &self,
-        _dir: &Path,
-        _step: u64,
+        _run: &Run,
+        _save: Save,
         _template: &Snapshot,
         _particles: bool,
     ) -> anyhow::Result<Snapshot> {
@@ -143,27 +186,95 @@ pub trait Peer: Sync {
     /// Whether a run of [`Peer::inrun_script`] writes the walls' every-step mean forces to
     /// [`inrun::WALLS_FILE`] in its folder ([`inrun::read_wall_means`]: every `contact_every`
     /// steps the mean over those steps of the force the free particles exert on the bottom [0]
-    /// and top [1] wall spheres, force units).
+    /// and top [1] wall spheres, force units); the default: no.
     fn writes_wall_means(&self) -> bool {
         false
     }
+}
 
-    /// Whether [`Peer::read_contacts`] can give its contact forces at all (a cross-run without
-    /// them compares particles only).
-    fn has_contact_forces(&self) -> bool {
-        true
+/// Why a peer cannot do what verdem asks of it, in words ("it has no two-sphere collision
+/// run"): a capability it lacks, not a failure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct Lacks(pub &'static str);
+
+/// What it lacks, when `e` says a peer lacks a capability ([`Lacks`]).
+pub fn lacks(e: &anyhow::Error) -> Option<Lacks> {
+    e.downcast_ref::<Lacks>().copied()
+}
+
+/// Where a peer runs: its run folder and its number of processes (MPI ranks) or threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Run<'a> {
+    pub dir: &'a Path,
+    pub np: usize,
+}
+
+/// One save of a peer's run: `index` its place in the run's sequence of saves (0 the one at
+/// step 0), `step` the step it was made at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Save {
+    pub index: u64,
+    pub step: u64,
+}
+
+impl Save {
+    /// Save `index` of a run saving every `every` steps from step 0.
+    pub fn every(every: u64, index: u64) -> Save {
+        Save {
+            index,
+            step: index * every,
+        }
+    }
+}
+
+/// How a peer is started in its run folder ([`Peer::launch`]): environment variables, program
+/// and arguments, and the files the command line names besides them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Launch {
+    pub env: Vec<(&'static str, String)>,
+    pub program: PathBuf,
+    pub args: Vec<String>,
+    /// An input file it reads that its arguments do not name (`kratos.json`).
+    pub reads: Option<&'static str>,
+    /// The file its standard output and error go to, when not to verdem.
+    pub log: Option<&'static str>,
+}
+
+impl Launch {
+    /// The command, to be run in `dir`; standard output and error are the caller's to direct
+    /// (to [`Launch::log`] when it names one).
+    pub fn command(&self, dir: &Path) -> Command {
+        let mut c = Command::new(&self.program);
+        c.args(&self.args)
+            .envs(self.env.iter().map(|(k, v)| (k, v)))
+            .current_dir(dir);
+        c
     }
 
-    /// The number of steps the pair of a collision run in `dir` ([`Peer::collision_script`])
-    /// overlapped at the end of a step, where the peer records it.
-    fn contact_steps(&self, _dir: &Path) -> anyhow::Result<Option<u64>> {
-        Ok(None)
+    /// Whether it is started by `mpirun`: its processes are MPI ranks.
+    pub fn by_mpirun(&self) -> bool {
+        self.program == Path::new(MPIRUN.name)
     }
+}
 
-    /// Whether `verdem bench` times it when no `--peers` are given: false for a peer so slow
-    /// that the default rounds would take hours (it is timed when named).
-    fn timed_by_default(&self) -> bool {
-        true
+/// `VAR=VALUE … PROGRAM ARGS… [(reads FILE)] [> LOG 2>&1]`.
+impl fmt::Display for Launch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (k, v) in &self.env {
+            write!(f, "{k}={v} ")?;
+        }
+        write!(f, "{}", self.program.display())?;
+        for a in &self.args {
+            write!(f, " {a}")?;
+        }
+        if let Some(file) = self.reads {
+            write!(f, " (reads {file})")?;
+        }
+        if let Some(log) = self.log {
+            write!(f, " > {log} 2>&1")?;
+        }
+        Ok(())
     }
 }
 
@@ -319,6 +430,25 @@ pub fn contact_of(s: &Snapshot, a: usize, b: usize, on_a: Vec3, spring_on_a: Vec
     }
 }
 
+/// The contacts of the MercuryCG `.fstat` save `path` (the format verdem writes,
+/// [`mercury::fstat_text`]) as verdem contacts of the state `s` (its particles at that save,
+/// the file's indices): a line's force on its particle i is fn·n + ft·t, a pair written from
+/// both sides is taken once ([`contact_of`]), and as the file gives the spring's length only,
+/// springs are zero. Sorted by `(p, i)`; an index beyond `s`'s particles is an error naming the
+/// file and line.
+pub fn mercury_contacts(path: &Path, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
+    let file = mercury::parse_fstat(&mut crate::io::open(path)?, Some(s.particles.len()))?;
+    let mut pairs = std::collections::BTreeMap::new();
+    for r in &file.rows {
+        pairs
+            .entry((r.i.min(r.j), r.i.max(r.j)))
+            .or_insert_with(|| {
+                contact_of(s, r.i, r.j, r.fn_signed * r.n + r.ft * r.t, Vec3::zeros())
+            });
+    }
+    Ok(pairs.into_values().collect())
+}
+
 /// Every known peer.
 pub fn all() -> &'static [&'static dyn Peer] {
     ALL
@@ -337,6 +467,12 @@ pub fn bench_names() -> String {
         .map(|p| p.name())
         .collect::<Vec<_>>()
         .join(",")
+}
+
+/// The names of all known peers, comma- and space-separated (`lammps, liggghts`), for help
+/// texts.
+pub fn listed() -> String {
+    known(", ")
 }
 
 /// The names of all known peers, joined by `sep`.
@@ -373,7 +509,7 @@ pub fn listing(peers: &[&dyn Peer]) -> String {
                 p.name(),
                 p.binary(),
                 p.convention().name(),
-                p.command_line(1),
+                p.launch(1),
                 p.installed()
             )
         })
@@ -402,14 +538,14 @@ pub(crate) struct Naming {
     pub hint: &'static str,
 }
 
-/// The end of a peer's in-run sample at `step` in `dir` ([`Peer::read_sample`]): the particles
+/// The end of a peer's in-run sample at `save` of `run` ([`Peer::read_sample`]): the particles
 /// in contact moved to the positions `placed` (index, position) that its positions file `path`
 /// gives, then `peer`'s contacts on that state. A contact with a particle `placed` lacks is an
 /// error naming the file and both particles.
 pub(crate) fn placed_contacts<P: Peer + ?Sized>(
     peer: &P,
-    dir: &Path,
-    step: u64,
+    run: &Run,
+    save: Save,
     mut s: Snapshot,
     (path, placed): (&Path, Vec<(usize, Vec3)>),
     name: &Naming,
@@ -419,18 +555,19 @@ pub(crate) fn placed_contacts<P: Peer + ?Sized>(
         s.particles.x[a] = x;
         seen[a] = true;
     }
-    s.contacts = peer.read_contacts(dir, step, &s)?;
+    s.contacts = peer.read_contacts(run, save, &s)?;
     if let Some(c) = s
         .contacts
         .iter()
         .find(|c| !seen[c.p as usize] || !seen[c.i as usize])
     {
         bail!(
-            "{}: the contact of {} {} and {} in contacts.{step}.txt has {} missing here{}",
+            "{}: the contact of {} {} and {} in contacts.{}.txt has {} missing here{}",
             path.display(),
             name.many,
             c.p + name.base,
             c.i + name.base,
+            save.step,
             name.a,
             name.hint
         );
@@ -442,22 +579,86 @@ pub(crate) fn placed_contacts<P: Peer + ?Sized>(
 mod tests {
     use super::*;
 
+    /// The names of [`all`], in its order, by the text every listing is made of.
+    fn all_names() -> Vec<&'static str> {
+        all().iter().map(|p| p.name()).collect()
+    }
+
     #[test]
     fn names_are_parsed_once_and_unknown_ones_listed() {
-        assert_eq!(names(), "lammps,liggghts,yade,kratos");
-        assert_eq!(by_name("liggghts").unwrap().binary(), "liggghts");
+        let names_of_all = all_names();
+        assert!(names_of_all.len() >= 2, "{names_of_all:?}");
+        assert_eq!(names(), names_of_all.join(","));
+        assert_eq!(listed(), names_of_all.join(", "));
+        for p in all() {
+            assert_eq!(by_name(p.name()).unwrap(), *p);
+        }
         let e = by_name("mechsys").unwrap_err().to_string();
         assert_eq!(
             e,
-            "unknown peer \"mechsys\" (known: lammps, liggghts, yade, kratos)"
+            format!(
+                "unknown peer \"mechsys\" (known: {})",
+                names_of_all.join(", ")
+            )
         );
-        let list = parse_list("liggghts,lammps").unwrap();
+        let (first, last) = (names_of_all[0], names_of_all[names_of_all.len() - 1]);
+        let list = parse_list(&format!("{last},{first}")).unwrap();
         assert_eq!(
             list.iter().map(|p| p.name()).collect::<Vec<_>>(),
-            ["liggghts", "lammps"]
+            [last, first]
         );
         assert!(parse_list("").unwrap().is_empty());
-        assert!(parse_list("lammps,lmp").is_err());
+        assert!(parse_list(&format!("{first},{first}x")).is_err());
+    }
+
+    /// A `.fstat` save verdem writes reads back as the same contacts: each pair once, P the
+    /// lower index, the same force on it; a free–wall pair written from one side only.
+    #[test]
+    fn mercury_contacts_read_back_what_fstat_text_wrote() {
+        use crate::state::{Domain, Motion, Particles};
+        let mut p = Particles::default();
+        for (x, m) in [
+            (1.0, Motion::Free),
+            (1.9, Motion::Free),
+            (2.8, Motion::Prescribed(0)),
+        ] {
+            p.push(
+                Vec3::new(x, 2.0, 2.0),
+                Vec3::zeros(),
+                Vec3::zeros(),
+                0.5,
+                1.0,
+                m,
+            );
+        }
+        let mut s = Snapshot {
+            step: 0,
+            time: 0.0,
+            domain: Domain::new(Vec3::zeros(), Vec3::new(4.0, 4.0, 4.0), [false; 3]),
+            particles: p,
+            contacts: Vec::new(),
+        };
+        let on_p = [Vec3::new(-3.0, 0.25, 0.0), Vec3::new(-1.0, 0.0, 0.5)];
+        s.contacts = [(0, 1), (1, 2)]
+            .into_iter()
+            .zip(on_p)
+            .map(|((a, b), f)| contact_of(&s, a, b, f, Vec3::zeros()))
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.fstat.0000");
+        std::fs::write(&path, mercury::fstat_text(&s)).unwrap();
+        let back = mercury_contacts(&path, &s).unwrap();
+        assert_eq!(back.len(), 2);
+        for (c, want) in back.iter().zip(&s.contacts) {
+            assert_eq!((c.p, c.i), (want.p, want.i));
+            assert!((c.force.f - want.force.f).norm() < 1e-12, "{c:?} {want:?}");
+            assert!((c.force.fn_signed - want.force.fn_signed).abs() < 1e-12);
+        }
+        // the contact (1, 2) names particle 2, which a two-particle state lacks
+        let mut few = s.clone();
+        few.particles.x.truncate(2);
+        let e = mercury_contacts(&path, &few).unwrap_err();
+        assert!(format!("{e:#}").contains("t.fstat.0000"), "{e:#}");
     }
 
     #[test]

@@ -106,15 +106,6 @@ impl MotionPeer {
         }
     }
 
-    /// Whether it is the library of the cross-run peer named `peer` (`lammps` has two pair
-    /// styles).
-    pub fn belongs_to(self, peer: &str) -> bool {
-        match self.flavour() {
-            Flavour::Lammps => peer == Lammps::NAME,
-            Flavour::Liggghts => peer == Liggghts::NAME,
-        }
-    }
-
     fn flavour(self) -> Flavour {
         match self {
             MotionPeer::Lammps | MotionPeer::LammpsHookeHistory => Flavour::Lammps,

@@ -25,11 +25,12 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
 
 use anyhow::{bail, ensure, Context};
 
-use super::{placed_contacts, wall_speeds, Frame, Installed, Naming, Peer, Program};
+use super::{
+    placed_contacts, wall_speeds, Frame, Installed, Lacks, Launch, Naming, Peer, Program, Run, Save,
+};
 use crate::case::{Case, Tangential};
 use crate::child::{self, OnParentDeath};
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
@@ -299,11 +300,12 @@ impl Peer for Yade {
     /// `positions.STEP.txt` is an error.
     fn read_sample(
         &self,
-        dir: &Path,
-        step: u64,
+        run: &Run,
+        save: Save,
         template: &Snapshot,
         particles: bool,
     ) -> anyhow::Result<Snapshot> {
+        let (dir, step) = (run.dir, save.step);
         let mut s = template.clone();
         s.step = step;
         s.contacts.clear();
@@ -338,12 +340,12 @@ impl Peer for Yade {
             base: 0,
             hint: "",
         };
-        placed_contacts(self, dir, step, s, (&path, placed), &bodies)
+        placed_contacts(self, run, save, s, (&path, placed), &bodies)
     }
 
     /// The fixed sphere is blocked at rest; the normal force's duration is recorded.
-    fn collision_script(&self, case: &Case, state: &str, steps: u64) -> String {
-        script(
+    fn collision_script(&self, case: &Case, state: &str, steps: u64) -> Result<String, Lacks> {
+        Ok(script(
             &Params {
                 case,
                 state,
@@ -354,25 +356,32 @@ impl Peer for Yade {
                 wall_vx: None,
             },
             &format!("a two-sphere collision, {steps} steps"),
-        )
+        ))
     }
 
     /// `OMP_WAIT_POLICY=PASSIVE`: with libgomp's default (spinning) a second thread on a
     /// shared core slows Yade down many times.
-    fn run(&self, np: usize, dir: &Path, input: &str) -> anyhow::Result<f64> {
-        let dir = &dir
+    fn launch(&self, np: usize) -> Launch {
+        Launch {
+            env: vec![("OMP_WAIT_POLICY", "PASSIVE".into())],
+            program: "yade".into(),
+            args: ["-j", &np.to_string(), "-n", "-x", SCRIPT]
+                .map(String::from)
+                .to_vec(),
+            reads: None,
+            log: None,
+        }
+    }
+
+    fn run(&self, run: &Run, input: &str) -> anyhow::Result<f64> {
+        let dir = &run
+            .dir
             .canonicalize()
-            .with_context(|| dir.display().to_string())?;
+            .with_context(|| run.dir.display().to_string())?;
         let script = dir.join(SCRIPT);
         std::fs::write(&script, input).with_context(|| script.display().to_string())?;
-        let out = child::output(
-            Command::new("yade")
-                .args(["-j", &np.to_string(), "-n", "-x", SCRIPT])
-                .env("OMP_WAIT_POLICY", "PASSIVE")
-                .current_dir(dir),
-            OnParentDeath::Kill,
-        )
-        .context("cannot start yade (install: apt-get install -y yade)")?;
+        let out = child::output(&mut self.launch(run.np).command(dir), OnParentDeath::Kill)
+            .context("cannot start yade (install: apt-get install -y yade)")?;
         let text = String::from_utf8_lossy(&out.stdout).to_string()
             + &String::from_utf8_lossy(&out.stderr);
         let seconds = text.lines().find_map(|l| {
@@ -391,20 +400,18 @@ impl Peer for Yade {
         }
     }
 
-    fn command_line(&self, np: usize) -> String {
-        format!("OMP_WAIT_POLICY=PASSIVE yade -j {np} -n -x {SCRIPT}")
+    /// `save.STEP.txt` in the run folder: positions wrapped into the box, full-step
+    /// velocities.
+    fn read_frame(&self, run: &Run, save: Save) -> anyhow::Result<Frame> {
+        let path = run.dir.join(format!("save.{}.txt", save.step));
+        Ok(read_bodies(&path, save.step)?)
     }
 
-    /// `save.STEP.txt` in `dir`: positions wrapped into the box, full-step velocities.
-    fn read_frame(&self, dir: &Path, step: u64) -> anyhow::Result<Frame> {
-        Ok(read_bodies(&dir.join(format!("save.{step}.txt")), step)?)
-    }
-
-    /// `contacts.STEP.txt` in `dir`: the forces the law applied at that step (elastic part
+    /// `contacts.STEP.txt` in the run folder: the forces the law applied at that step (elastic part
     /// stored by Yade, the dashpot recomputed from the same velocities) and the elastic spring
     /// (Yade's stored elastic force over ks).
-    fn read_contacts(&self, dir: &Path, step: u64, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
-        let path = dir.join(format!("contacts.{step}.txt"));
+    fn read_contacts(&self, run: &Run, save: Save, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
+        let path = run.dir.join(format!("contacts.{}.txt", save.step));
         let x = &s.particles.x;
         let mut out = Vec::new();
         for r in read_rows(&path, 8)? {
@@ -475,14 +482,19 @@ mod tests {
             "# step 7\n1 0 -2.0 0.5 0.0 0.001 0.0 0.0\n",
         )
         .unwrap();
-        let c = Yade.read_contacts(dir.path(), 7, &pair()).unwrap();
+        let run = Run {
+            dir: dir.path(),
+            np: 1,
+        };
+        let save = |step| Save { index: 1, step };
+        let c = Yade.read_contacts(&run, save(7), &pair()).unwrap();
         assert_eq!(c.len(), 1);
         assert_eq!((c[0].p, c[0].i), (0, 1));
         assert_eq!(c[0].force.f, Vec3::new(2.0, -0.5, 0.0));
         assert_eq!(c[0].force.fn_signed, 2.0);
         assert_eq!(c[0].spring, Vec3::new(-0.001, 0.0, 0.0));
         std::fs::write(dir.path().join("contacts.8.txt"), "0 5 1 2 3 4 5 6\n").unwrap();
-        let e = Yade.read_contacts(dir.path(), 8, &pair()).unwrap_err();
+        let e = Yade.read_contacts(&run, save(8), &pair()).unwrap_err();
         assert!(e.to_string().contains("out of range"), "{e}");
     }
 

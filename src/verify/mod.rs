@@ -71,6 +71,18 @@ pub fn error_row(case: &str, error: &anyhow::Error) -> Row {
         .described(format!("{error:#}"), String::new())
 }
 
+/// A row saying that a case was not run because a peer lacks what it needs (`why`, in words:
+/// `toy: it has no two-sphere collision run`): not judged (`info`), gating nothing.
+pub fn lacking_row(case: &str, why: &str) -> Row {
+    Verdict::reported(case, "not run: the peer lacks it", f64::NAN, Limit::None)
+        .described(why.into(), String::new())
+}
+
+/// Whether `r` is a [`lacking_row`].
+pub fn is_lacking(r: &Row) -> bool {
+    r.limit == Limit::None && r.outcome == Outcome::Reported && r.measured.is_nan()
+}
+
 /// Whether `r` is an [`error_row`].
 pub fn is_error(r: &Row) -> bool {
     r.limit == Limit::None && r.outcome == Outcome::Fail
@@ -370,14 +382,15 @@ pub fn all(dir: &Path) -> anyhow::Result<Vec<Row>> {
 pub use crate::analysis::verdict::failures;
 
 /// The table as text; tolerances marked `abs` are absolute, the others relative. A failed row
-/// that documents a peer convention's known defect reads `FAIL*`.
+/// that documents a peer convention's known defect reads `FAIL*`; an [`error_row`] and a
+/// [`lacking_row`] have no numbers, their words on the lines below.
 pub fn table(rows: &[Row]) -> String {
     let mut s = format!(
         "{:<56} {:<48} {:>13} {:>13} {:>13}  result\n",
         "case", "quantity", "expected", "measured", "tolerance"
     );
     for r in rows {
-        if is_error(r) {
+        if is_error(r) || is_lacking(r) {
             s.push_str(&format!(
                 "{:<56} {:<48} {:>55}  {}\n",
                 r.case,
