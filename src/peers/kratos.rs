@@ -310,9 +310,9 @@ impl Peer for Kratos {
         Ok(settings(case, state, steps, steps, true))
     }
 
-    /// Runs the driver with [`python`] in `dir` with `np` OpenMP threads (Kratos' MPI build
-    /// needs a partitioned model; verdem runs its shared-memory one); Kratos' output goes to
-    /// `kratos.log` there.
+    /// The driver run by [`python`] with `np` OpenMP threads (Kratos' MPI build needs a
+    /// partitioned model; verdem runs its shared-memory one); Kratos' output goes to
+    /// `kratos.log` in the run folder.
     fn launch(&self, np: usize) -> Launch {
         Launch {
             env: vec![("OMP_NUM_THREADS", np.to_string())],
@@ -323,6 +323,8 @@ impl Peer for Kratos {
         }
     }
 
+    /// Writes the settings and the driver into the run folder, then runs [`Peer::launch`]'s
+    /// command there.
     fn run(&self, run: &Run, input: &str) -> anyhow::Result<f64> {
         let dir = &run
             .dir
@@ -370,8 +372,9 @@ impl Peer for Kratos {
             .with_context(|| format!("{}: no '{LOOP_LINE}' line", log_path.display()))
     }
 
-    /// `dump.STEP.txt` in the run folder. Kratos' symplectic Euler step keeps the velocity that moved
-    /// the sphere over the last step: verdem's half-step velocity v(t − dt/2), not v(t).
+    /// `dump.STEP.txt` in the run folder. Kratos' symplectic Euler step keeps the velocity
+    /// that moved the sphere over the last step: verdem's half-step velocity v(t − dt/2), not
+    /// v(t).
     fn read_frame(&self, run: &Run, save: Save) -> anyhow::Result<Frame> {
         Ok(dump::read(
             &run.dir.join(format!("dump.{}.txt", save.step)),

@@ -495,8 +495,8 @@ fix             still2 top    move linear 0 0 0\n\
         )?)
     }
 
-    /// `contacts.STEP.txt` in the run folder: the contact forces are re-evaluated at the end of the
-    /// step, with full-step velocities in the dashpots where the step itself used half-step
+    /// `contacts.STEP.txt` in the run folder: the contact forces are re-evaluated at the end of
+    /// the step, with full-step velocities in the dashpots where the step itself used half-step
     /// velocities; the tangential springs are not dumped, so `xi` is zero.
     fn read_contacts(&self, run: &Run, save: Save, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
         let path = run.dir.join(format!("contacts.{}.txt", save.step));

@@ -407,9 +407,9 @@ impl Peer for Yade {
         Ok(read_bodies(&path, save.step)?)
     }
 
-    /// `contacts.STEP.txt` in the run folder: the forces the law applied at that step (elastic part
-    /// stored by Yade, the dashpot recomputed from the same velocities) and the elastic spring
-    /// (Yade's stored elastic force over ks).
+    /// `contacts.STEP.txt` in the run folder: the forces the law applied at that step (elastic
+    /// part stored by Yade, the dashpot recomputed from the same velocities) and the elastic
+    /// spring (Yade's stored elastic force over ks).
     fn read_contacts(&self, run: &Run, save: Save, s: &Snapshot) -> anyhow::Result<Vec<Contact>> {
         let path = run.dir.join(format!("contacts.{}.txt", save.step));
         let x = &s.particles.x;
