@@ -7,7 +7,7 @@ use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
 use verdem::state::memory;
 
-use super::args::{complete_series, count, named, positive};
+use super::args::{complete_series, count, described, positive};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -25,10 +25,11 @@ pub struct Args {
     #[arg(
         long,
         default_value = CgOptions::default().kernel.name(),
-        value_parser = named(&KernelChoice::ALL, KernelChoice::name)
+        value_parser = described(&KernelChoice::ALL, KernelChoice::name, KernelChoice::description)
     )]
     kernel: KernelChoice,
-    /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
+    /// Kernel width: Gauss (and MercuryCG Gauss) standard deviation or Lucy cutoff (default: the
+    /// slice height).
     #[arg(long, allow_negative_numbers = true, value_parser = positive)]
     width: Option<f64>,
     /// Case file telling which particles are walls and the density (default: the
