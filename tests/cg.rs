@@ -4,6 +4,7 @@ mod common;
 
 use std::path::Path;
 
+use sha2::Digest;
 use verdem::analysis::cg::{self, CgOptions, KernelChoice, COLUMNS};
 use verdem::io::mercury;
 
@@ -736,6 +737,16 @@ fn heaviside_and_mercury_gauss_agree_with_mercurycg_to_its_printed_digits() {
             }
         }
     }
+    let mut data = Vec::new();
+    for k in 0..3 {
+        data.extend(std::fs::read(dir.path().join(format!("s.data.{k:04}"))).unwrap());
+    }
+    // SHA-256 of MercuryCG's input `ref.data` (data/README.md, "MercuryCG reference profiles")
+    assert_eq!(
+        format!("{:x}", sha2::Sha256::digest(&data)),
+        "f569e92d1cc3aede84e138883f73a4857addcdaf27bd818a431c25c99e6b0b38",
+        "the steady case's first 200 steps no longer give the saves MercuryCG coarse-grained"
+    );
     let reference = std::fs::read_to_string(common::data("mercurycg/steady_200.fstat")).unwrap();
     assert!(
         fstat == reference,
@@ -787,4 +798,68 @@ fn heaviside_and_mercury_gauss_agree_with_mercurycg_to_its_printed_digits() {
 
 fn profiles_of(base: &Path, o: &CgOptions) -> cg::Profiles {
     cg::coarse_grain(&cg::Series::find(base).unwrap(), o).unwrap()
+}
+
+/// `verdem cg --kernel mercury-gauss` is offered, described and applied: on a contact whose
+/// branch reaches beyond 3 widths of some slices its profiles differ from `--kernel gauss`'s in
+/// the contact stress, pressure and shear stress only.
+#[test]
+fn the_command_line_offers_mercury_gauss() {
+    let help = common::verdem_ok(["cg", "--help"]).stdout;
+    let help = String::from_utf8_lossy(&help);
+    assert!(
+        help.contains("mercury-gauss") && help.contains("uncut Gaussian"),
+        "{help}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let parts = [([2.6, 2.0, 6.3], [0.0; 3]), ([2.0, 2.0, 4.4], [0.0; 3])];
+    let (nx, nz) = (0.6 / 1.9924, 1.9 / 1.9924);
+    let row = |a: usize, b: usize, s: f64| {
+        format!("0 {a} {b} 2 2 5 0.01 0 2 0 {} 0 {} 0 0 0", s * nx, s * nz)
+    };
+    for k in 0..2 {
+        save(dir.path(), k, &parts, &[row(0, 1, 1.0), row(1, 0, -1.0)]);
+    }
+    let base = dir.path().join("s");
+    let csv = |kernel: &str| -> Vec<Vec<f64>> {
+        common::verdem_ok([
+            "cg",
+            base.to_str().unwrap(),
+            "--kernel",
+            kernel,
+            "--width",
+            "0.3",
+            "--slices",
+            "40",
+            "--from",
+            "0",
+            "--blocks",
+            "1",
+            "--case",
+            "cases/verify/binary_collision.toml",
+        ]);
+        let text = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let (gauss, mercury) = (csv("gauss"), csv("mercury-gauss"));
+    let header = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();
+    let names: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+    let mut differing = std::collections::BTreeSet::new();
+    for (g, m) in gauss.iter().zip(&mercury) {
+        for (c, (a, b)) in g.iter().zip(m).enumerate() {
+            if a != b {
+                differing.insert(names[c].trim());
+            }
+        }
+    }
+    assert!(
+        !differing.is_empty()
+            && differing.iter().all(|n| ["con_", "pressure", "shear_xz"]
+                .iter()
+                .any(|c| n.starts_with(c))),
+        "{differing:?}"
+    );
 }
