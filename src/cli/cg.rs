@@ -7,7 +7,7 @@ use verdem::analysis::cg::{self, CgOptions, KernelChoice};
 use verdem::case::Case;
 use verdem::state::memory;
 
-use super::args::{complete_series, count, described, positive};
+use super::args::{complete_series, count, named, positive};
 use super::Finished;
 
 #[derive(clap::Args)]
@@ -22,10 +22,13 @@ pub struct Args {
     to: Option<u64>,
     #[arg(long, default_value_t = CgOptions::default().slices, value_parser = count::<usize>)]
     slices: usize,
+    /// Kernel: heaviside slices; gauss (cut off at 3 widths, renormalised); mercury-gauss
+    /// (MercuryCG's Gauss: the same for particles, a contact's branch weighed by the uncut
+    /// Gaussian); lucy.
     #[arg(
         long,
         default_value = CgOptions::default().kernel.name(),
-        value_parser = described(&KernelChoice::ALL, KernelChoice::name, KernelChoice::description)
+        value_parser = named(&KernelChoice::ALL, KernelChoice::name)
     )]
     kernel: KernelChoice,
     /// Kernel width: Gauss (and MercuryCG Gauss) standard deviation or Lucy cutoff (default: the

@@ -144,24 +144,6 @@ impl KernelChoice {
             KernelChoice::Lucy => "lucy",
         }
     }
-
-    /// What it is, for `--help`.
-    pub fn description(self) -> &'static str {
-        match self {
-            KernelChoice::Heaviside => {
-                "slices of the slice height (MercuryCG `-function Heaviside`)"
-            }
-            KernelChoice::Gauss => {
-                "Gaussian of standard deviation --width, cut off at 3 widths and renormalised; a \
-                 contact's branch takes its exact line integral"
-            }
-            KernelChoice::MercuryGauss => {
-                "MercuryCG's `-function Gauss`: gauss for the particles; a contact's branch takes \
-                 the line integral of the uncut Gaussian, scaled to unit integral over z"
-            }
-            KernelChoice::Lucy => "Lucy polynomial of cutoff --width",
-        }
-    }
 }
 
 /// A series of saves on disk.
