@@ -4,6 +4,7 @@ mod common;
 
 use std::path::Path;
 
+use sha2::Digest;
 use verdem::analysis::cg::{self, CgOptions, KernelChoice, COLUMNS};
 use verdem::io::mercury;
 
@@ -678,4 +679,192 @@ fn an_incomplete_save_is_said_or_skipped_with_a_warning() {
         assert_eq!(series.saves, [0, 1, 3]);
         assert_eq!(incomplete.len(), 1);
     }
+}
+
+/// MercuryCG's `.stat` rows (`data/mercurycg/`, provenance in `data/README.md`): per row its
+/// z and the raw fields verdem computes, in verdem's order: ν, ρ, momentum (3), momentum flux
+/// (xx xy xz yy yz zz), contact stress (xx xy xz yx yy yz zx zy zz).
+fn mercurycg_rows(name: &str) -> Vec<(f64, Vec<f64>)> {
+    let text = std::fs::read_to_string(common::data(&format!("mercurycg/{name}"))).unwrap();
+    text.lines()
+        .skip(2)
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            (v[1], v[2..22].to_vec())
+        })
+        .collect()
+}
+
+/// The same raw fields of verdem's profiles at grid point k, averaged over the saves as
+/// MercuryCG's `-timeaverage`.
+fn verdem_row(p: &cg::Profiles, k: usize) -> Vec<f64> {
+    let n = p.per_save.len() as f64;
+    let mean = |f: &dyn Fn(&cg::fields::Raw) -> f64| p.per_save.iter().map(f).sum::<f64>() / n;
+    let mut row = vec![mean(&|r| r.nu[k]), mean(&|r| r.rho[k])];
+    row.extend((0..3).map(|a| mean(&|r| r.momentum[k][a])));
+    for (a, b) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)] {
+        row.push(mean(&|r| r.flux[k][(a, b)]));
+    }
+    for a in 0..3 {
+        row.extend((0..3).map(|b| mean(&|r| r.contact[k][(a, b)])));
+    }
+    row
+}
+
+/// `--kernel heaviside` and `--kernel mercury-gauss` against MercuryCG's own output on three
+/// saves 100 steps apart of the steady case (data/README.md: the MercuryDPM commit and the exact
+/// commands): every raw field of every core slice (z in [3, 19], where the wall spheres, which
+/// MercuryCG weighs as particles, do not reach) agrees to MercuryCG's six printed digits.
+/// `--kernel gauss` differs from it in the contact stress: the convention `mercury-gauss` is for.
+#[test]
+fn heaviside_and_mercury_gauss_agree_with_mercurycg_to_its_printed_digits() {
+    let case = verdem::case::Case::load(&common::root().join("cases/shear_flow_steady.toml"))
+        .expect("case loads");
+    let init = common::root().join("golden/full_run/shear_flow.final.data");
+    let dir = tempfile::tempdir().unwrap();
+    let mut e = common::engine(&case, Some(&init), Default::default());
+    common::run_with_saves(e.as_mut(), dir.path(), "s", 200, 100);
+    // MercuryCG's input: the three saves' contacts with j >= i, the rows its reader keeps (it
+    // skips the others' remainders with ignore(256), shorter than verdem's rows).
+    let mut fstat = String::new();
+    for k in 0..3 {
+        let text = std::fs::read_to_string(dir.path().join(format!("s.fstat.{k:04}"))).unwrap();
+        for l in text.lines() {
+            let c: Vec<&str> = l.split_whitespace().collect();
+            if l.starts_with('#') || c[2].parse::<usize>().unwrap() >= c[1].parse().unwrap() {
+                fstat.push_str(l);
+                fstat.push('\n');
+            }
+        }
+    }
+    let mut data = Vec::new();
+    for k in 0..3 {
+        data.extend(std::fs::read(dir.path().join(format!("s.data.{k:04}"))).unwrap());
+    }
+    // SHA-256 of MercuryCG's input `ref.data` (data/README.md, "MercuryCG reference profiles")
+    assert_eq!(
+        format!("{:x}", sha2::Sha256::digest(&data)),
+        "f569e92d1cc3aede84e138883f73a4857addcdaf27bd818a431c25c99e6b0b38",
+        "the steady case's first 200 steps no longer give the saves MercuryCG coarse-grained"
+    );
+    let reference = std::fs::read_to_string(common::data("mercurycg/steady_200.fstat")).unwrap();
+    assert!(
+        fstat == reference,
+        "the steady case's first 200 steps no longer give data/mercurycg/steady_200.fstat: the \
+         MercuryCG reference was made from other saves"
+    );
+    for (kernel, file) in [
+        (KernelChoice::Heaviside, "steady_200.heaviside.stat"),
+        (KernelChoice::MercuryGauss, "steady_200.gauss.stat"),
+        (KernelChoice::Gauss, "steady_200.gauss.stat"),
+    ] {
+        let o = CgOptions {
+            from: Some(0),
+            slices: 100,
+            kernel,
+            width: Some(0.22),
+            blocks: 1,
+            ..CgOptions::for_case(&case)
+        };
+        let p = profiles_of(&dir.path().join("s"), &o);
+        let rows = mercurycg_rows(file);
+        assert_eq!(rows.len(), 72, "{file}");
+        let mut worst_contact: f64 = 0.0;
+        for (z, theirs) in &rows {
+            let k = ((z - p.grid.z0) / p.grid.h()).floor() as usize;
+            assert!((p.grid.z(k) - z).abs() < 1e-4, "{file}: z = {z}");
+            let ours = verdem_row(&p, k);
+            for (c, (a, b)) in ours.iter().zip(theirs).enumerate() {
+                // six significant digits: half a unit of the sixth (and round-off), zero exact
+                let unit = if *b == 0.0 {
+                    0.0
+                } else {
+                    10f64.powf(b.abs().log10().floor() - 5.0)
+                };
+                let tol = 0.5 * unit * (1.0 + 1e-9);
+                if kernel == KernelChoice::Gauss && c >= 11 {
+                    worst_contact = worst_contact.max((a - b).abs() / b.abs().max(1e-300));
+                } else {
+                    assert!(
+                        (a - b).abs() <= tol,
+                        "{kernel:?} at z = {z}, column {c}: verdem {a} vs MercuryCG {b}"
+                    );
+                }
+            }
+        }
+        if kernel == KernelChoice::Gauss {
+            assert!(
+                worst_contact > 1e-4,
+                "gauss matches MercuryCG: {worst_contact}"
+            );
+        }
+    }
+}
+
+fn profiles_of(base: &Path, o: &CgOptions) -> cg::Profiles {
+    cg::coarse_grain(&cg::Series::find(base).unwrap(), o).unwrap()
+}
+
+/// `verdem cg --kernel mercury-gauss` is offered, described and applied: on a contact whose
+/// branch reaches beyond 3 widths of some slices its profiles differ from `--kernel gauss`'s in
+/// the contact stress, pressure and shear stress only.
+#[test]
+fn the_command_line_offers_mercury_gauss() {
+    let help = common::verdem_ok(["cg", "--help"]).stdout;
+    let help = String::from_utf8_lossy(&help);
+    assert!(
+        help.contains("mercury-gauss") && help.contains("uncut Gaussian"),
+        "{help}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let parts = [([2.6, 2.0, 6.3], [0.0; 3]), ([2.0, 2.0, 4.4], [0.0; 3])];
+    let (nx, nz) = (0.6 / 1.9924, 1.9 / 1.9924);
+    let row = |a: usize, b: usize, s: f64| {
+        format!("0 {a} {b} 2 2 5 0.01 0 2 0 {} 0 {} 0 0 0", s * nx, s * nz)
+    };
+    for k in 0..2 {
+        save(dir.path(), k, &parts, &[row(0, 1, 1.0), row(1, 0, -1.0)]);
+    }
+    let base = dir.path().join("s");
+    let csv = |kernel: &str| -> Vec<Vec<f64>> {
+        common::verdem_ok([
+            "cg",
+            base.to_str().unwrap(),
+            "--kernel",
+            kernel,
+            "--width",
+            "0.3",
+            "--slices",
+            "40",
+            "--from",
+            "0",
+            "--blocks",
+            "1",
+            "--case",
+            "cases/verify/binary_collision.toml",
+        ]);
+        let text = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let (gauss, mercury) = (csv("gauss"), csv("mercury-gauss"));
+    let header = std::fs::read_to_string(dir.path().join("s.profiles.csv")).unwrap();
+    let names: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+    let mut differing = std::collections::BTreeSet::new();
+    for (g, m) in gauss.iter().zip(&mercury) {
+        for (c, (a, b)) in g.iter().zip(m).enumerate() {
+            if a != b {
+                differing.insert(names[c].trim());
+            }
+        }
+    }
+    assert!(
+        !differing.is_empty()
+            && differing.iter().all(|n| ["con_", "pressure", "shear_xz"]
+                .iter()
+                .any(|c| n.starts_with(c))),
+        "{differing:?}"
+    );
 }

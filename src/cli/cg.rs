@@ -22,13 +22,17 @@ pub struct Args {
     to: Option<u64>,
     #[arg(long, default_value_t = CgOptions::default().slices, value_parser = count::<usize>)]
     slices: usize,
+    /// Kernel: heaviside slices; gauss (cut off at 3 widths, renormalised); mercury-gauss
+    /// (MercuryCG's Gauss: the same for particles, a contact's branch weighed by the uncut
+    /// Gaussian); lucy.
     #[arg(
         long,
         default_value = CgOptions::default().kernel.name(),
         value_parser = named(&KernelChoice::ALL, KernelChoice::name)
     )]
     kernel: KernelChoice,
-    /// Kernel width: Gauss standard deviation or Lucy cutoff (default: the slice height).
+    /// Kernel width: Gauss (and MercuryCG Gauss) standard deviation or Lucy cutoff (default: the
+    /// slice height).
     #[arg(long, allow_negative_numbers = true, value_parser = positive)]
     width: Option<f64>,
     /// Case file telling which particles are walls and the density (default: the

@@ -34,7 +34,8 @@ pub struct CgOptions {
     pub to: Option<u64>,
     pub slices: usize,
     pub kernel: KernelChoice,
-    /// Kernel width (Gauss: standard deviation; Lucy: cutoff); default the slice height.
+    /// Kernel width (Gauss and MercuryGauss: standard deviation; Lucy: cutoff); default the
+    /// slice height.
     pub width: Option<f64>,
     /// Particles with index < `walls` are wall spheres (the benchmark: 480).
     pub walls: usize,
@@ -90,8 +91,8 @@ impl CgOptions {
 impl CgOptions {
     /// Where and how these options coarse-grain a box from `lo` to `hi` (length): the box with
     /// these options' periodic axes, `slices` slices along z, and the kernel on them (Heaviside
-    /// slices of the slices' height, or a Gauss or Lucy kernel of `width`, default the slice
-    /// height). The saves' coarse-graining and in-run averaging both take it from here.
+    /// slices of the slices' height, or a Gauss, MercuryCG Gauss or Lucy kernel of `width`,
+    /// default the slice height). The saves' coarse-graining and in-run averaging both take it from here.
     pub fn frame(&self, lo: crate::Vec3, hi: crate::Vec3) -> (Domain, Grid, Kernel) {
         let grid = Grid {
             z0: lo.z,
@@ -109,6 +110,7 @@ impl CgOptions {
         match self.kernel {
             KernelChoice::Heaviside => Kernel::Heaviside { h },
             KernelChoice::Gauss => Kernel::Gauss { w: width },
+            KernelChoice::MercuryGauss => Kernel::MercuryGauss { w: width },
             KernelChoice::Lucy => Kernel::Lucy { c: width },
         }
     }
@@ -119,14 +121,17 @@ impl CgOptions {
 pub enum KernelChoice {
     Heaviside,
     Gauss,
+    /// MercuryCG's Gaussian ([`Kernel::MercuryGauss`]).
+    MercuryGauss,
     Lucy,
 }
 
 impl KernelChoice {
     /// Every family.
-    pub const ALL: [KernelChoice; 3] = [
+    pub const ALL: [KernelChoice; 4] = [
         KernelChoice::Heaviside,
         KernelChoice::Gauss,
+        KernelChoice::MercuryGauss,
         KernelChoice::Lucy,
     ];
 
@@ -135,6 +140,7 @@ impl KernelChoice {
         match self {
             KernelChoice::Heaviside => "heaviside",
             KernelChoice::Gauss => "gauss",
+            KernelChoice::MercuryGauss => "mercury-gauss",
             KernelChoice::Lucy => "lucy",
         }
     }
