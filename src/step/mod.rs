@@ -30,6 +30,7 @@ mod arrays;
 pub mod core;
 pub mod counters;
 mod energy;
+pub mod engine;
 mod forces;
 pub mod guard;
 mod integrate;
@@ -40,12 +41,13 @@ use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
 pub use self::energy::{Flows, LedgerRow, Reading};
+pub use self::engine::Engine;
 use self::forces::{book_dropped, contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
-use crate::state::{History, SampledContact, Snapshot};
+use crate::state::SampledContact;
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
@@ -59,130 +61,16 @@ pub struct Simulation<L: ContactLaw> {
     pub(crate) core: Core<L::History>,
 }
 
-/// The law-independent face of a simulation, for the run loop and the tools.
-pub trait Engine: Send {
-    /// The dynamic state (particles in memory order; see [`Engine::snapshot`]).
-    fn state(&self) -> &State;
-    /// The settings of the step.
-    fn params(&self) -> &Params;
-    /// The same, to change between calls of [`Engine::advance`].
-    fn params_mut(&mut self) -> &mut Params;
-    /// Time per stage and rebuilds since the counters were last reset.
-    fn counters(&self) -> &StageTimes;
-    /// The same, to reset.
-    fn counters_mut(&mut self) -> &mut StageTimes;
-    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
-    fn snapshot(&self) -> Snapshot;
-    /// The active contacts, as [`Snapshot::contacts`] has them, with their particles' positions
-    /// and radii: a sample of the contact stress without a snapshot of every particle.
-    fn contact_sample(&self) -> Vec<SampledContact>;
-    /// Takes [`Engine::contact_sample`] inside every later run at each step that is a multiple
-    /// of `every` (0: never), once that step's forces are evaluated, without stopping the run.
-    fn sample_contacts_every(&mut self, every: u64);
-    /// The contact samples taken inside runs since the last call, by step, in step order.
-    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)>;
-    /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
-    /// carry this law's history ([`Engine::history_words`] words each).
-    fn restore(&mut self, snap: &Snapshot);
-    /// Words of the canonical form of the contact law's history.
-    fn history_words(&self) -> usize;
-    /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
-    fn rebuild(&mut self);
-    /// Number of pairs in contact at the last force evaluation.
-    fn contact_count(&self) -> usize;
-    /// Number of candidate pairs at the last build.
-    fn pair_count(&self) -> usize;
-    /// Largest overlap of any contact in any step run so far, as a fraction of the pair's
-    /// smaller radius (0 before the first step; the guard stops a run beyond `[guard] overlap`).
-    fn deepest_overlap(&self) -> f64;
-    /// Largest excess of a contact's energy account in any step run so far, as a fraction of
-    /// the energy the contact took (0 when none gave out more than it took; the guard stops a
-    /// run beyond `[guard] contact`).
-    fn largest_excess(&self) -> f64;
-    /// The ledgers read at the current step ([`Reading`]; the forces of the step evaluated):
-    /// the energy and momentum flows accumulated over every step run so far, and the state's
-    /// energies and free momentum. Two readings give the ledgers of the steps between them.
-    fn ledger(&self) -> Reading;
-    /// The ledgers' flows accumulated over every step run so far (those of [`Engine::ledger`]).
-    fn flows(&self) -> Flows;
-    /// Sets the accumulated flows: a run resumed from a checkpoint continues those of the run
-    /// that wrote it.
-    fn set_flows(&mut self, flows: Flows);
-    /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
-    /// with the reason, when the run guard finds a number that cannot be trusted; after that
-    /// every call fails the same way.
-    fn advance(&mut self, steps: u64) -> Result<(), Failure>;
-}
+/// Steps of a window of the run guard's energy balance: short enough that a slow instability is
+/// stopped long before a save of the benchmark (every 50000 steps), long enough that measuring
+/// the energy (a pass over the particles and the pairs) and starting the team of threads again
+/// cost nothing against the steps; `verdem run` advances in blocks of this length anyway.
+pub const ENERGY_WINDOW: u64 = 2000;
 
-impl<L: ContactLaw> Engine for Simulation<L> {
-    fn state(&self) -> &State {
-        &self.core.state
-    }
-    fn params(&self) -> &Params {
-        &self.core.params
-    }
-    fn params_mut(&mut self) -> &mut Params {
-        self.core.energy_at = None;
-        &mut self.core.params
-    }
-    fn counters(&self) -> &StageTimes {
-        &self.core.counters
-    }
-    fn counters_mut(&mut self) -> &mut StageTimes {
-        &mut self.core.counters
-    }
-    fn snapshot(&self) -> Snapshot {
-        self.core.snapshot()
-    }
-    fn contact_sample(&self) -> Vec<SampledContact> {
-        self.core.contact_sample()
-    }
-    fn sample_contacts_every(&mut self, every: u64) {
-        self.core.params.contact_every = every;
-    }
-    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)> {
-        std::mem::take(&mut self.core.contact_samples)
-    }
-    fn restore(&mut self, snap: &Snapshot) {
-        self.core.restore(snap)
-    }
-    fn history_words(&self) -> usize {
-        <L::History as History>::WORDS
-    }
-    fn rebuild(&mut self) {
-        self.rebuild_booked()
-    }
-    fn contact_count(&self) -> usize {
-        self.core.contact_count()
-    }
-    fn pair_count(&self) -> usize {
-        self.core.pair_count()
-    }
-    fn deepest_overlap(&self) -> f64 {
-        self.core.deepest
-    }
-    fn largest_excess(&self) -> f64 {
-        self.core.pumped
-    }
-    fn ledger(&self) -> Reading {
-        let c = &self.core;
-        let s = &c.state;
-        energy::read(
-            &self.law,
-            &s.particles,
-            &s.domain,
-            c.params.gravity,
-            &c.pairs,
-            (s.step, c.params.dt, c.flows),
-        )
-    }
-    fn flows(&self) -> Flows {
-        self.core.flows
-    }
-    fn set_flows(&mut self, flows: Flows) {
-        self.core.flows = flows;
-    }
-    fn advance(&mut self, steps: u64) -> Result<(), Failure> {
+impl<L: ContactLaw> Simulation<L> {
+    /// [`Engine::advance`]: the initial forces if needed, then `steps` steps in windows of
+    /// [`ENERGY_WINDOW`], each closed by the run guard's energy balance.
+    fn advance_in_windows(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
             // The state given is checked before its forces are evaluated and saved, so that no
             // save or diagnostics row is made of velocities the guard would refuse.
@@ -224,15 +112,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         }
         self.core.failure.clone().map_or(Ok(()), Err)
     }
-}
 
-/// Steps of a window of the run guard's energy balance: short enough that a slow instability is
-/// stopped long before a save of the benchmark (every 50000 steps), long enough that measuring
-/// the energy (a pass over the particles and the pairs) and starting the team of threads again
-/// cost nothing against the steps; `verdem run` advances in blocks of this length anyway.
-pub const ENERGY_WINDOW: u64 = 2000;
-
-impl<L: ContactLaw> Simulation<L> {
     /// The mechanical energy of the current state ([`energy::measure`]).
     fn energy(&self) -> energy::Energy {
         let c = &self.core;
@@ -778,9 +658,9 @@ mod tests {
     use super::{Core, Simulation};
     use crate::case::Case;
     use crate::contact::ContactLaw;
-    use crate::engine::{self, LawVisitor};
     use crate::neighbor::NeighborBuilder;
     use crate::scene::Scene;
+    use crate::step::engine::{self, LawVisitor};
     use std::path::Path;
 
     /// Runs `steps` steps of the scene on one thread under the case's law, then checks the

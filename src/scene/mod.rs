@@ -1,5 +1,7 @@
 //! Scenes: the bumpy-wall shear geometry (generated or read from a file) and explicit sphere
-//! lists.
+//! lists; [`tile`], the benchmark cell tiled for timing against system size.
+
+pub mod tile;
 
 use std::path::Path;
 
