@@ -47,7 +47,7 @@ use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
-use crate::state::SampledContact;
+use crate::state::{Domain, SampledContact};
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
@@ -226,84 +226,28 @@ impl<L: ContactLaw> Simulation<L> {
         if steps == 0 {
             return 0;
         }
-        let core = &mut self.core;
         // The run guard: velocities set since the last run are checked once here; within the
         // run only contact forces can make them otherwise, and those are checked.
-        if let Some(b) = guard::not_finite(&core.state.particles) {
-            let state = &core.state;
-            core.failure = Some(b.report(state.step, state.time, &state.id));
+        if let Some(b) = guard::not_finite(&self.core.state.particles) {
+            let state = &self.core.state;
+            self.core.failure = Some(b.report(state.step, state.time, &state.id));
             return 0;
         }
-        let threads = core.params.threads;
-        let chunks = core.work.plan.chunks(core.state.particles.len());
-        let bound = core.work.moved_bound;
-        let skin = core.work.builder.skin;
-        core.work.plan.reset_live();
-        let domain = core.state.domain.clone();
-        let params = &core.params;
-        let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
-        let (contact_every, first_step) = (params.contact_every, core.state.step);
-        let guard = params.guard;
-        let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
-        let periodic_gravity = params
-            .gravity
-            .map(|g| energy::periodic_part(g, &domain))
-            .filter(|g| *g != Vec3::zeros());
-        let mut list = core.list_state();
-        let arrays = Shared::new(Arrays::of(&mut list));
-        let team = Team {
-            threads,
-            bind: bind && threads > 1,
-            barrier: SpinBarrier::new(threads),
-            speeds: (0..threads)
-                .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
-                .collect(),
-            particle_queue: WorkQueue::new(threads, chunks),
-            pair_queue: WorkQueue::new(threads, chunks),
-            pairs_done: Marks::new(chunks),
-            rebuild_queue: WorkQueue::new(threads, chunks),
-            list: Shared::new(list),
-            arrays,
-            meet,
-            law: &self.law,
-            guard,
-            alarm: Alarm::default(),
-            kick: Kick {
-                domain: &domain,
-                dt,
-                gravity,
-                periodic_gravity,
-            },
-            skin,
-            contact_every,
-            first_step,
-        };
-        let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
-        let done = if threads == 1 {
-            work_of(0)
-        } else {
-            std::thread::scope(|s| {
-                let handles: Vec<_> = (1..threads)
-                    .map(|tid| {
-                        let work_of = &work_of;
-                        s.spawn(move || work_of(tid))
-                    })
-                    .collect();
-                let mut mine = work_of(0);
-                for h in handles {
-                    let theirs = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-                    // an integer sum: the same in any order of the threads
-                    mine.supplied += theirs.supplied;
-                    mine.flows.add(&theirs.flows);
-                    mine.deepest = mine.deepest.max(theirs.deepest);
-                    mine.pumped = mine.pumped.max(theirs.pumped);
-                    mine.samples.extend(theirs.samples);
-                }
-                mine
-            })
-        };
+        let bound = self.core.work.moved_bound;
+        let domain = self.core.state.domain.clone();
+        let team = Team::new(&mut self.core, &self.law, &domain);
+        let done =
+            team.on_every_thread(|tid| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps));
         let breach = team.alarm.take();
+        self.close_run(done, breach)
+    }
+
+    /// Books what the threads of a run left (`done`, merged) into the core: counters, bounds,
+    /// the steps and time reached, the ledgers' flows, and the run guard's first breach as the
+    /// simulation's failure. Returns the work supplied, as [`Simulation::run`] does.
+    fn close_run(&mut self, done: Done, breach: Option<(u64, guard::Breach)>) -> i128 {
         let core = &mut self.core;
+        let dt = core.params.dt;
         core.counters.add_times(&done.times);
         core.counters.rebuilds += done.times.rebuilds;
         core.work.moved_bound = done.bound;
@@ -344,6 +288,18 @@ struct Done {
     samples: Vec<(u64, Vec<SampledContact>)>,
 }
 
+impl Done {
+    /// Adds what another thread of the same run left.
+    fn merge(&mut self, theirs: Done) {
+        // an integer sum: the same in any order of the threads
+        self.supplied += theirs.supplied;
+        self.flows.add(&theirs.flows);
+        self.deepest = self.deepest.max(theirs.deepest);
+        self.pumped = self.pumped.max(theirs.pumped);
+        self.samples.extend(theirs.samples);
+    }
+}
+
 /// What the threads of a run share.
 struct Team<'a, L: ContactLaw> {
     threads: usize,
@@ -371,6 +327,78 @@ struct Team<'a, L: ContactLaw> {
     contact_every: u64,
     /// The step the run starts from.
     first_step: u64,
+}
+
+impl<'a, L: ContactLaw> Team<'a, L> {
+    /// The team of a run of `core` under `law` in the box `domain` (the state's, borrowed for
+    /// the run): `core.params.threads` threads, work queues of the chunks of the current plan
+    /// (their live ends reset), the shared views of the arrays, and the step's parameters.
+    fn new(core: &'a mut Core<L::History>, law: &'a L, domain: &'a Domain) -> Self {
+        let threads = core.params.threads;
+        let chunks = core.work.plan.chunks(core.state.particles.len());
+        let skin = core.work.builder.skin;
+        core.work.plan.reset_live();
+        let params = &core.params;
+        let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
+        let (contact_every, first_step) = (params.contact_every, core.state.step);
+        let guard = params.guard;
+        let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
+        let periodic_gravity = params
+            .gravity
+            .map(|g| energy::periodic_part(g, domain))
+            .filter(|g| *g != Vec3::zeros());
+        let mut list = core.list_state();
+        let arrays = Shared::new(Arrays::of(&mut list));
+        Team {
+            threads,
+            bind: bind && threads > 1,
+            barrier: SpinBarrier::new(threads),
+            speeds: (0..threads)
+                .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
+                .collect(),
+            particle_queue: WorkQueue::new(threads, chunks),
+            pair_queue: WorkQueue::new(threads, chunks),
+            pairs_done: Marks::new(chunks),
+            rebuild_queue: WorkQueue::new(threads, chunks),
+            list: Shared::new(list),
+            arrays,
+            meet,
+            law,
+            guard,
+            alarm: Alarm::default(),
+            kick: Kick {
+                domain,
+                dt,
+                gravity,
+                periodic_gravity,
+            },
+            skin,
+            contact_every,
+            first_step,
+        }
+    }
+
+    /// Runs `work_of(tid)` on every thread of the team, thread 0 on this one and the others
+    /// spawned for the run, and merges what they leave in thread order ([`Done::merge`]). A
+    /// thread's panic is resumed here.
+    fn on_every_thread(&self, work_of: impl Fn(usize) -> Done + Sync) -> Done {
+        if self.threads == 1 {
+            return work_of(0);
+        }
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (1..self.threads)
+                .map(|tid| {
+                    let work_of = &work_of;
+                    s.spawn(move || work_of(tid))
+                })
+                .collect();
+            let mut mine = work_of(0);
+            for h in handles {
+                mine.merge(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+            }
+            mine
+        })
+    }
 }
 
 /// One thread of a run: its share of every stage, and its own counters.
