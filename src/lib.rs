@@ -11,6 +11,7 @@ pub mod case;
 pub mod child;
 pub mod contact;
 pub mod ensemble;
+pub mod file_name;
 pub mod io;
 pub mod neighbor;
 pub mod peers;

@@ -12,8 +12,7 @@ use crate::contact::{
     TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
-use crate::scene::Scene;
-use crate::state::{History, SampledContact, Snapshot};
+use crate::state::{Domain, History, Particles, SampledContact, Snapshot};
 use crate::Vec3;
 
 /// The law-independent face of a simulation, for the run loop and the tools.
@@ -142,6 +141,15 @@ impl<L: ContactLaw> Engine for Simulation<L> {
     fn advance(&mut self, steps: u64) -> Result<(), Failure> {
         self.advance_in_windows(steps)
     }
+}
+
+/// The initial state of a run, which [`build`] makes a simulation of ([`crate::scene::build`]
+/// makes one from a case).
+pub struct Scene {
+    pub domain: Domain,
+    pub particles: Particles,
+    /// Start time (that of the `.data` file it was read from, else 0).
+    pub time: f64,
 }
 
 /// Overrides of the case's numerical settings (command line).

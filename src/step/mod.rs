@@ -687,7 +687,7 @@ mod tests {
     use crate::case::Case;
     use crate::contact::ContactLaw;
     use crate::neighbor::NeighborBuilder;
-    use crate::scene::Scene;
+    use crate::step::engine::Scene;
     use crate::step::engine::{self, LawVisitor};
     use std::path::Path;
 
