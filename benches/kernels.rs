@@ -16,7 +16,7 @@ use verdem::contact::{
     ContactLaw, Frictionless, FrictionlessLaw, LinearSpringDashpot, MercuryLaw,
     MercurySlidingFriction, PairInput,
 };
-use verdem::engine::{self, Overrides};
+use verdem::step::engine::{self, Overrides};
 use verdem::step::Engine;
 use verdem::Vec3;
 

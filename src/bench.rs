@@ -12,8 +12,8 @@ use anyhow::Context;
 use crate::analysis::stats::{hinges, median, median_interval};
 use crate::analysis::{Limit, Outcome, Verdict};
 use crate::case::Case;
-use crate::engine::{self, Overrides};
 use crate::peers::Peer;
+use crate::step::engine::{self, Overrides};
 use crate::step::StageTimes;
 use crate::team::{round_trip_ns, Bound, SpinBarrier};
 

@@ -452,14 +452,14 @@ impl Case {
                 Err(err(table, key, format!("must be >= 0, got {v}")))
             }
         };
-        if !crate::io::plain_file_name(&self.name) {
+        if !crate::file_name::plain_file_name(&self.name) {
             return Err(err(
                 "",
                 "name",
                 format!(
                     "must be a plain file name (1 to {} bytes, no '/', no control character, not \
                      '.' or '..'), got {:?}",
-                    crate::io::NAME_BYTES,
+                    crate::file_name::NAME_BYTES,
                     self.name
                 ),
             ));

@@ -10,10 +10,9 @@ pub mod bench;
 pub mod case;
 pub mod child;
 pub mod contact;
-pub mod engine;
 pub mod ensemble;
+pub mod file_name;
 pub mod io;
-pub mod kinematics;
 pub mod neighbor;
 pub mod peers;
 pub mod python;
@@ -23,7 +22,7 @@ pub mod stability;
 pub mod state;
 pub mod step;
 pub mod team;
-pub mod tile;
+pub mod tradeoff;
 pub mod verify;
 
 /// Three-component vector of `f64` used for positions, velocities, forces and torques.

@@ -3,7 +3,11 @@
 
 mod cli;
 
+use std::error::Error;
+
 use clap::{Parser, Subcommand};
+use verdem::run::RunError;
+use verdem::step::guard::Failure;
 
 use cli::{Finished, EXIT_GUARD, EXIT_INTERRUPTED};
 
@@ -86,14 +90,92 @@ fn main() {
         Command::Vtk(a) => cli::vtk::exec(a),
         Command::Extremes(a) => cli::extremes::exec(a),
     };
+    if let Err(e) = &outcome {
+        eprintln!("error: {e:#}");
+    }
+    match exit_status(&outcome) {
+        0 => {}
+        status => std::process::exit(status),
+    }
+}
+
+/// The exit status of a command that ended with `outcome`: 0 when done, [`EXIT_INTERRUPTED`]
+/// for a run a signal stopped, 1 when checks failed or on an error, [`EXIT_GUARD`] when the
+/// error is the run guard's, by its type however the layers above wrapped it
+/// ([`guard_stopped`]). A usage error exits with 2 before a command starts (clap's
+/// `Cli::parse`).
+fn exit_status(outcome: &anyhow::Result<Finished>) -> i32 {
     match outcome {
-        Ok(Finished::Done) => {}
-        Ok(Finished::Interrupted) => std::process::exit(EXIT_INTERRUPTED),
-        Ok(Finished::ChecksFailed) => std::process::exit(1),
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            let guard = e.downcast_ref::<verdem::step::guard::Failure>().is_some();
-            std::process::exit(if guard { EXIT_GUARD } else { 1 });
+        Ok(Finished::Done) => 0,
+        Ok(Finished::Interrupted) => EXIT_INTERRUPTED,
+        Ok(Finished::ChecksFailed) => 1,
+        Err(e) if e.chain().any(guard_stopped) => EXIT_GUARD,
+        Err(_) => 1,
+    }
+}
+
+/// Whether the error `e` (one link of a chain of causes) is the run guard's stop: a
+/// [`Failure`], a [`RunError::Guard`], or a [`RunError::Other`] that holds one.
+fn guard_stopped(e: &(dyn Error + 'static)) -> bool {
+    match e.downcast_ref::<RunError>() {
+        Some(RunError::Guard(_)) => true,
+        Some(RunError::Other(inner)) => inner.chain().any(guard_stopped),
+        None => e.is::<Failure>(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn failure() -> Failure {
+        Failure {
+            step: 7,
+            time: 0.5,
+            ids: vec![3],
+            what: "a velocity is not finite".into(),
+            remedy: "a smaller time step",
+            kept: None,
         }
+    }
+
+    #[test]
+    fn a_command_that_ends_without_an_error_exits_by_how_it_finished() {
+        assert_eq!(exit_status(&Ok(Finished::Done)), 0);
+        assert_eq!(exit_status(&Ok(Finished::Interrupted)), EXIT_INTERRUPTED);
+        assert_eq!(exit_status(&Ok(Finished::ChecksFailed)), 1);
+    }
+
+    /// The run guard's stop exits with [`EXIT_GUARD`] however it is carried: as it is, inside
+    /// the run loop's error, under context added by the layers above, or inside the run loop's
+    /// other errors; every other error exits with 1.
+    #[test]
+    fn the_guard_s_stop_exits_with_its_status_however_it_is_wrapped() {
+        use anyhow::Context;
+        let status = |e: anyhow::Error| exit_status(&Err(e));
+        assert_eq!(status(failure().into()), EXIT_GUARD);
+        assert_eq!(status(RunError::Guard(failure()).into()), EXIT_GUARD);
+        let wrapped = Err::<(), _>(RunError::Guard(failure())).context("replica 2");
+        assert_eq!(status(wrapped.unwrap_err()), EXIT_GUARD);
+        let carried = Err::<(), _>(failure())
+            .context("the reference run")
+            .unwrap_err();
+        assert_eq!(status(RunError::Other(carried).into()), EXIT_GUARD);
+        assert_eq!(status(anyhow::anyhow!("cannot read a.data")), 1);
+        let other = RunError::Other(anyhow::anyhow!("disk full"));
+        assert_eq!(status(other.into()), 1);
+        // a failure flattened into text is an error like any other: the reason for the types
+        assert_eq!(status(anyhow::anyhow!("{}", failure())), 1);
+    }
+
+    /// The run loop's error says what the guard's failure says, to the letter.
+    #[test]
+    fn the_run_loop_s_error_keeps_the_failure_s_message() {
+        let f = failure();
+        let e: anyhow::Error = RunError::Guard(f.clone()).into();
+        assert_eq!(format!("{e:#}"), f.to_string());
+        let inner = anyhow::anyhow!("disk full").context("save 3 was not written");
+        let e: anyhow::Error = RunError::Other(inner).into();
+        assert_eq!(format!("{e:#}"), "save 3 was not written: disk full");
     }
 }

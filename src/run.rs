@@ -12,6 +12,7 @@ use crate::io::checkpoint::{Ledgers, Resumed, RunRecord};
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
 use crate::io::{atomic, csv_table, mercury, vtk};
 use crate::state::SampledContact;
+use crate::step::guard::Failure;
 use crate::step::{Engine, Reading, StageTimes};
 
 /// Options of one run.
@@ -241,6 +242,19 @@ pub trait Observer {
     fn state(&self) -> Vec<u8>;
 }
 
+/// Why a run stopped short of its end step.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The run guard stopped it: a number it could no longer trust (`verdem run` exits with
+    /// status 3). Its message names what is kept on disk.
+    #[error(transparent)]
+    Guard(#[from] Failure),
+    /// Anything else: a file not read or written, a refused checkpoint, an observer's error,
+    /// with its message.
+    #[error(transparent)]
+    Other(#[from] anyhow::Error),
+}
+
 /// Where a run starts.
 #[derive(Clone, Copy)]
 enum Start<'a> {
@@ -255,7 +269,7 @@ pub fn run(
     engine: &mut dyn Engine,
     opts: &RunOptions,
     resumed: bool,
-) -> anyhow::Result<RunSummary> {
+) -> Result<RunSummary, RunError> {
     run_observed(engine, opts, resumed, None)
 }
 
@@ -265,7 +279,7 @@ pub fn run_observed(
     opts: &RunOptions,
     resumed: bool,
     observer: Option<&mut dyn Observer>,
-) -> anyhow::Result<RunSummary> {
+) -> Result<RunSummary, RunError> {
     let start = if resumed {
         Start::Resumed(None)
     } else {
@@ -282,7 +296,7 @@ pub fn run_resumed(
     opts: &RunOptions,
     resumed: &Resumed,
     observer: Option<&mut dyn Observer>,
-) -> anyhow::Result<RunSummary> {
+) -> Result<RunSummary, RunError> {
     run_from(
         engine,
         opts,
@@ -326,7 +340,7 @@ fn run_from(
     opts: &RunOptions,
     start: Start<'_>,
     mut observer: Option<&mut dyn Observer>,
-) -> anyhow::Result<RunSummary> {
+) -> Result<RunSummary, RunError> {
     let resumed = matches!(start, Start::Resumed(_));
     std::fs::create_dir_all(&opts.out_dir)
         .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
@@ -476,12 +490,12 @@ struct Kept {
 
 impl Kept {
     /// The error of a run stopped by the run guard: its failure and what is kept on disk.
-    fn stopped(&self, mut f: crate::step::guard::Failure) -> anyhow::Error {
+    fn stopped(&self, mut f: Failure) -> RunError {
         f.kept = Some(format!(
             "nothing was written after the last good state: {}",
             self.listed()
         ));
-        anyhow::Error::new(f)
+        RunError::Guard(f)
     }
 
     /// The error of a run stopped because a file could not be written (a full disk, a

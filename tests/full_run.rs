@@ -19,7 +19,7 @@ use sha2::{Digest, Sha256};
 use verdem::analysis::cg::{self, blocking, table::Table, CgOptions, COLUMNS};
 use verdem::analysis::difference::CoreMean;
 use verdem::analysis::inrun::{self, Inrun};
-use verdem::engine::Overrides;
+use verdem::step::engine::Overrides;
 
 fn golden(name: &str) -> std::path::PathBuf {
     common::root().join("golden/full_run").join(name)

@@ -5,9 +5,9 @@
 mod common;
 
 use common::*;
-use verdem::engine::Overrides;
 use verdem::io::mercury;
 use verdem::run;
+use verdem::step::engine::Overrides;
 
 fn golden(name: &str, how: &str, body: String) {
     insta::with_settings!({

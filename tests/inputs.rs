@@ -10,9 +10,9 @@ use std::process::Command;
 
 use proptest::prelude::*;
 use verdem::case::Case;
-use verdem::engine::{self, Overrides};
 use verdem::io::{self, checkpoint, mercury, official, Lines};
 use verdem::peers::lammps_family::dump;
+use verdem::step::engine::{self, Overrides};
 use verdem::step::Engine;
 
 /// A file of the corpus.
@@ -173,7 +173,7 @@ fn the_corpus_seeds_are_valid() {
     );
     let (file, text) = io::read_text(&corpus("motion.csv")).unwrap();
     assert_eq!(
-        verdem::kinematics::parse_motion(&file, &text)
+        verdem::verify::kinematics::parse_motion(&file, &text)
             .unwrap()
             .len(),
         20
@@ -1347,7 +1347,7 @@ fn table_seed(name: &str) -> Vec<u8> {
             + "verdem,1,100,1e6,100 101,3480,1000,287.3,1,1,\n\
                lammps,2,90,9e5,90 91,3480,1000,319.2,1.1,,\n")
             .into_bytes(),
-        "tradeoff" => verdem::analysis::tradeoff::csv(&[]).into_bytes(),
+        "tradeoff" => verdem::tradeoff::csv(&[]).into_bytes(),
         _ => unreachable!("no seed table {name}"),
     }
 }
@@ -1483,15 +1483,15 @@ proptest! {
         arbitrary_text(vec![first_line("motion.csv")])
     ]) {
         match io::utf8("f", b.clone()) {
-            Ok(text) => named(verdem::kinematics::parse_motion("f", &text), "f", &b)?,
+            Ok(text) => named(verdem::verify::kinematics::parse_motion("f", &text), "f", &b)?,
             Err(e) => named(Err::<(), _>(e), "f", &b)?,
         }
     }
 
     #[test]
-    fn fuzz_forces(b in arbitrary_text(vec![verdem::kinematics::forces_csv(&[])])) {
+    fn fuzz_forces(b in arbitrary_text(vec![verdem::verify::kinematics::forces_csv(&[])])) {
         if let Ok(text) = String::from_utf8(b.clone()) {
-            named(verdem::kinematics::parse_forces_lines("f", &text), "f", &b)?;
+            named(verdem::verify::kinematics::parse_forces_lines("f", &text), "f", &b)?;
         }
     }
 
@@ -1567,7 +1567,7 @@ proptest! {
     fn fuzz_tradeoff_table(b in table("tradeoff")) {
         if let Ok(text) = String::from_utf8(b.clone()) {
             let p = Path::new("tradeoff.csv");
-            named(verdem::analysis::tradeoff::read_csv(&text, p), "tradeoff.csv", &b)?;
+            named(verdem::tradeoff::read_csv(&text, p), "tradeoff.csv", &b)?;
         }
     }
 }

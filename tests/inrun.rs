@@ -9,8 +9,8 @@ use verdem::analysis::inrun::{Inrun, Sampling};
 use verdem::analysis::stats::standard_error;
 use verdem::analysis::verdict::Outcome;
 use verdem::case::Case;
-use verdem::engine::Overrides;
 use verdem::run::{self, RunOptions};
+use verdem::step::engine::Overrides;
 use verdem::step::Engine;
 
 fn col(name: &str) -> usize {

@@ -12,8 +12,8 @@ mod common;
 
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use verdem::case::Case;
-use verdem::kinematics::{self, ForceRow, Increment, MotionRow};
 use verdem::peers::motion::{self, MotionPeer};
+use verdem::verify::kinematics::{self, ForceRow, Increment, MotionRow};
 use verdem::verify::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis, tangential_force};
 use verdem::verify::{self, ratchet, row_abs, Row};
 use verdem::Vec3;

@@ -6,8 +6,8 @@ mod common;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 
-use verdem::engine::Overrides;
 use verdem::peers::{self, lammps_family::data_file, Peer};
+use verdem::step::engine::Overrides;
 
 /// LAMMPS and LIGGGHTS, from the registry.
 fn lammps_and_liggghts() -> [&'static dyn Peer; 2] {

@@ -272,7 +272,11 @@ fn wall_lines(path: &std::path::Path) -> Vec<(u64, [verdem::Vec3; 2])> {
 
 /// verdem's state of `case` from `state`, its forces evaluated.
 fn snapshot(case: &Case, state: &std::path::Path) -> verdem::state::Snapshot {
-    let mut e = common::engine(case, Some(state), verdem::engine::Overrides::default());
+    let mut e = common::engine(
+        case,
+        Some(state),
+        verdem::step::engine::Overrides::default(),
+    );
     e.advance(0).unwrap();
     e.snapshot()
 }

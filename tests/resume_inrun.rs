@@ -10,10 +10,10 @@ use std::sync::Arc;
 use common::*;
 use verdem::analysis::cg::CgOptions;
 use verdem::analysis::inrun::{self, Inrun};
-use verdem::engine::Overrides;
 use verdem::io::checkpoint;
 use verdem::run::{self, Observer, RunOptions};
 use verdem::state::SampledContact;
+use verdem::step::engine::Overrides;
 use verdem::step::Engine;
 
 /// Steps of the run, a save every [`SAVE_EVERY`]: saves 0 to 8, the in-run window over the

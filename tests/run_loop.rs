@@ -3,9 +3,9 @@
 mod common;
 
 use common::*;
-use verdem::engine::Overrides;
 use verdem::io::mercury;
 use verdem::run::{self, RunOptions};
+use verdem::step::engine::Overrides;
 
 fn options(dir: &std::path::Path, end: u64, checkpoint_every: u64) -> RunOptions {
     RunOptions {

@@ -4,8 +4,8 @@ mod common;
 
 use common::*;
 use verdem::case::Search;
-use verdem::engine::Overrides;
 use verdem::io::mercury;
+use verdem::step::engine::Overrides;
 
 /// MercuryDPM's save 1 of the benchmark (t = 3.596, 50000 steps from its save 0) holds one
 /// contact, 948–1334, written to 10 significant digits. verdem started from the same save 0

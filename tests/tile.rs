@@ -6,8 +6,8 @@
 mod common;
 
 use verdem::case::{Case, Scene};
-use verdem::engine::Overrides;
 use verdem::state::{Motion, Snapshot};
+use verdem::step::engine::Overrides;
 
 /// The overlaps (length) of the contacts found by a force evaluation of the state, ascending.
 fn overlaps(s: &Snapshot) -> Vec<f64> {

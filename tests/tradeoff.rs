@@ -4,7 +4,7 @@
 mod common;
 
 use verdem::analysis::difference::{CoreMean, Difference};
-use verdem::analysis::tradeoff::{self, call, Bias, Call, Outcome, Plan, CONTROL, REFERENCE};
+use verdem::tradeoff::{self, call, Bias, Call, Outcome, Plan, CONTROL, REFERENCE};
 
 /// A bias of a variant (mean `delta` above a reference at 1.0) with both core means' standard
 /// error `se` with 19 degrees of freedom, relative to 1.0.

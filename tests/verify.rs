@@ -126,10 +126,10 @@ fn a_closed_cycle_returns_the_objective_laws_to_zero_force_and_ratchets_the_othe
 
 #[test]
 fn the_kinematics_command_writes_the_forces_of_the_driver() {
-    use verdem::kinematics::{drive, forces_csv, law_of, motion_csv, Increment};
+    use verdem::verify::kinematics::{drive, forces_csv, law_of, motion_csv, Increment};
     let case = load("objectivity.toml");
-    let (x, radius) = verdem::kinematics::pair_of(&case).unwrap();
-    let mut rows = vec![verdem::kinematics::MotionRow {
+    let (x, radius) = verdem::verify::kinematics::pair_of(&case).unwrap();
+    let mut rows = vec![verdem::verify::kinematics::MotionRow {
         t: 0.0,
         x,
         q: [nalgebra::UnitQuaternion::identity(); 2],
@@ -157,7 +157,7 @@ fn the_kinematics_command_writes_the_forces_of_the_driver() {
         forces.as_os_str(),
     ]);
     // the command reads the motion back (quaternions normalised) and drives the same law
-    let read = verdem::kinematics::parse_motion("m", &motion_csv(&rows)).unwrap();
+    let read = verdem::verify::kinematics::parse_motion("m", &motion_csv(&rows)).unwrap();
     let expected = forces_csv(&drive(
         law_of(&case).as_ref(),
         radius,
@@ -209,7 +209,9 @@ fn kinematics_cmd(
 /// coarse for the law's collision time while the spheres touch, writing the forces still.
 #[test]
 fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coarse_rows() {
-    use verdem::kinematics::{drive, forces_csv, law_of, motion_csv, parse_motion, Increment};
+    use verdem::verify::kinematics::{
+        drive, forces_csv, law_of, motion_csv, parse_motion, Increment,
+    };
     let dir = tempfile::tempdir().unwrap();
     let template =
         std::fs::read_to_string(common::root().join("cases/verify/objectivity.toml")).unwrap();
@@ -253,9 +255,9 @@ fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coars
     );
 
     let case = verdem::case::Case::load_for_prescribed_motion(&stiff).unwrap();
-    let tc = verdem::kinematics::collision_time(&case).unwrap();
-    let (x, radius) = verdem::kinematics::pair_of(&case).unwrap();
-    let start = verdem::kinematics::MotionRow {
+    let tc = verdem::verify::kinematics::collision_time(&case).unwrap();
+    let (x, radius) = verdem::verify::kinematics::pair_of(&case).unwrap();
+    let start = verdem::verify::kinematics::MotionRow {
         t: 0.0,
         x,
         q: [nalgebra::UnitQuaternion::identity(); 2],
@@ -264,7 +266,7 @@ fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coars
     };
     let spin = verdem::verify::objectivity::spin_sphere_2;
     let (motion, forces) = (dir.path().join("m.csv"), dir.path().join("f.csv"));
-    let expected = |rows: &[verdem::kinematics::MotionRow]| {
+    let expected = |rows: &[verdem::verify::kinematics::MotionRow]| {
         let read = parse_motion("m", &motion_csv(rows)).unwrap();
         forces_csv(&drive(
             law_of(&case).as_ref(),

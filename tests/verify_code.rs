@@ -9,8 +9,8 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use verdem::case::{Case, Tangential};
-use verdem::kinematics::{self, ForceRow, MotionRow};
 use verdem::verify::driver::{External, MotionDriver, OWN};
+use verdem::verify::kinematics::{self, ForceRow, MotionRow};
 use verdem::verify::{self, Row, Subject};
 
 fn cases() -> std::path::PathBuf {

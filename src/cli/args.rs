@@ -8,9 +8,9 @@ use verdem::analysis::cg::{self, Series};
 use verdem::analysis::report::Report;
 use verdem::analysis::Verdict;
 use verdem::case::Case;
-use verdem::engine::{self, Overrides};
 use verdem::io::lock::{self, FolderLock};
 use verdem::scene;
+use verdem::step::engine::{self, Overrides};
 use verdem::step::Engine;
 
 /// The case and how to run it (`run`, `hash`).

@@ -148,7 +148,7 @@ fn sweep(a: &Args, case_path: &Path, configs: &[Config]) -> anyhow::Result<Finis
     let mut sizes = Vec::new();
     for &n in &a.scale {
         let work = a.out.join(format!("{n}x{n}"));
-        let (case_file, state) = verdem::tile::write(case_path, &from, n, n, &work)?;
+        let (case_file, state) = verdem::scene::tile::write(case_path, &from, n, n, &work)?;
         let case = Case::load(&case_file)?;
         let particles = scene::build(&case, Some(&state))?.particles.len();
         sizes.push(Size {

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use verdem::case::{Case, COARSE_STEPS_PER_COLLISION};
 use verdem::io::{self, atomic};
-use verdem::kinematics::{self, Increment};
 use verdem::peers::motion::{self, MotionPeer};
+use verdem::verify::kinematics::{self, Increment};
 
 use super::args::described;
 use super::Finished;

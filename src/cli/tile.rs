@@ -24,7 +24,7 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let (case, state) = verdem::tile::write(&a.case, &a.from, a.nx, a.ny, &a.out)?;
+    let (case, state) = verdem::scene::tile::write(&a.case, &a.from, a.nx, a.ny, &a.out)?;
     println!("{}\n{}", case.display(), state.display());
     Ok(Finished::Done)
 }

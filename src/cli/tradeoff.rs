@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use verdem::analysis::tradeoff::{self, Plan};
 use verdem::case::Case;
 use verdem::io::atomic;
 use verdem::run;
+use verdem::tradeoff::{self, Plan};
 
 use super::args::{count, fraction, lock_output_folder, positive};
 use super::Finished;

@@ -29,12 +29,12 @@ use crate::analysis::cg::{self, CgOptions};
 use crate::analysis::ensemble::{self as merge, CoreCoverage, Coverage};
 use crate::analysis::inrun::{self, Inrun};
 use crate::case::Case;
-use crate::engine::{self, Overrides};
 use crate::io::lock;
 use crate::io::{atomic, hash};
 use crate::run::{self, RunOptions};
 use crate::scene;
 use crate::state::Particles;
+use crate::step::engine::{self, Overrides};
 
 /// What an ensemble is: the case, its start and the replicas' perturbation, how long each
 /// replica runs and where their files go.

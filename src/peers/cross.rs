@@ -31,9 +31,9 @@ use crate::analysis::inrun::{self, InrunResult, Sampling};
 use crate::analysis::stats::quantile;
 use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential};
-use crate::engine::{self, Overrides};
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
+use crate::step::engine::{self, Overrides};
 
 /// Largest, median and 99th-percentile value of a sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -1,5 +1,5 @@
 //! Prescribed motions in the real LAMMPS and LIGGGHTS: the same two-sphere motions that
-//! [`crate::kinematics::drive`] runs through verdem's laws, run through the peers' own contact
+//! [`crate::verify::kinematics::drive`] runs through verdem's laws, run through the peers' own contact
 //! laws, in process, through their C library interfaces ([`library`], loaded at run time).
 //!
 //! The input is the one the peers' cross-runs and binary collisions use
@@ -30,7 +30,7 @@
 //!
 //! Sphere 1 is atom 1 (i), sphere 2 atom 2 (j); forces and torques are each atom's `f` and
 //! `torque` after the step; the overlap, the signed normal force (the force on sphere 2 along n
-//! from 1 to 2) and the tangential magnitude are formed as in [`crate::kinematics`]. The case
+//! from 1 to 2) and the tangential magnitude are formed as in [`crate::verify::kinematics`]. The case
 //! gives the radii, the density and kn, gamman, kt, gammat, mu; its `tangential` and
 //! `clip_normal` are the peer's own (its [`MotionPeer::convention`], not clipped).
 
@@ -46,9 +46,9 @@ use super::lammps::Lammps;
 use super::lammps_family::{boundary, data_file, neighbor, Dialect, GROUPS};
 use super::liggghts::Liggghts;
 use crate::case::{Case, Scene, Tangential};
-use crate::kinematics::{pair_of, ForceRow, Increment, MotionRow};
 use crate::state::Snapshot;
 use crate::verify::driver::MotionDriver;
+use crate::verify::kinematics::{pair_of, ForceRow, Increment, MotionRow};
 use crate::Vec3;
 
 /// A peer whose contact law can be driven through a prescribed motion in process.
@@ -166,7 +166,7 @@ const SAME_STEP: f64 = 1e-9;
 static RUNNING: Mutex<()> = Mutex::new(());
 
 /// The step-average velocities of both spheres and the step of row `k` (row 0: its own
-/// velocities and no step), as [`crate::kinematics::drive`] takes them.
+/// velocities and no step), as [`crate::verify::kinematics::drive`] takes them.
 fn step_velocities(
     rows: &[MotionRow],
     k: usize,
@@ -253,7 +253,7 @@ impl MotionDriver for MotionPeer {
 
 /// Drives one contact of `case`'s two spheres through `motion` in `peer`'s library, with the
 /// increments of `increment`: the forces and torques at every row, with the semantics of
-/// [`crate::kinematics::drive`] (module doc). Times and lengths in the case's units.
+/// [`crate::verify::kinematics::drive`] (module doc). Times and lengths in the case's units.
 pub fn drive(
     peer: MotionPeer,
     case: &Case,

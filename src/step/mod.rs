@@ -30,6 +30,7 @@ mod arrays;
 pub mod core;
 pub mod counters;
 mod energy;
+pub mod engine;
 mod forces;
 pub mod guard;
 mod integrate;
@@ -40,12 +41,13 @@ use self::arrays::Arrays;
 pub use self::core::{Core, MeetHook, Params, State};
 pub use self::counters::StageTimes;
 pub use self::energy::{Flows, LedgerRow, Reading};
+pub use self::engine::Engine;
 use self::forces::{book_dropped, contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
 use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
-use crate::state::{History, SampledContact, Snapshot};
+use crate::state::{Domain, SampledContact};
 use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
@@ -59,130 +61,16 @@ pub struct Simulation<L: ContactLaw> {
     pub(crate) core: Core<L::History>,
 }
 
-/// The law-independent face of a simulation, for the run loop and the tools.
-pub trait Engine: Send {
-    /// The dynamic state (particles in memory order; see [`Engine::snapshot`]).
-    fn state(&self) -> &State;
-    /// The settings of the step.
-    fn params(&self) -> &Params;
-    /// The same, to change between calls of [`Engine::advance`].
-    fn params_mut(&mut self) -> &mut Params;
-    /// Time per stage and rebuilds since the counters were last reset.
-    fn counters(&self) -> &StageTimes;
-    /// The same, to reset.
-    fn counters_mut(&mut self) -> &mut StageTimes;
-    /// The state in canonical order (allocates; for saves, hashes and checkpoints).
-    fn snapshot(&self) -> Snapshot;
-    /// The active contacts, as [`Snapshot::contacts`] has them, with their particles' positions
-    /// and radii: a sample of the contact stress without a snapshot of every particle.
-    fn contact_sample(&self) -> Vec<SampledContact>;
-    /// Takes [`Engine::contact_sample`] inside every later run at each step that is a multiple
-    /// of `every` (0: never), once that step's forces are evaluated, without stopping the run.
-    fn sample_contacts_every(&mut self, every: u64);
-    /// The contact samples taken inside runs since the last call, by step, in step order.
-    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)>;
-    /// Overwrites the dynamic state from a canonical snapshot of the same scene whose contacts
-    /// carry this law's history ([`Engine::history_words`] words each).
-    fn restore(&mut self, snap: &Snapshot);
-    /// Words of the canonical form of the contact law's history.
-    fn history_words(&self) -> usize;
-    /// Re-orders the particles and rebuilds the pair list, keeping every contact's history.
-    fn rebuild(&mut self);
-    /// Number of pairs in contact at the last force evaluation.
-    fn contact_count(&self) -> usize;
-    /// Number of candidate pairs at the last build.
-    fn pair_count(&self) -> usize;
-    /// Largest overlap of any contact in any step run so far, as a fraction of the pair's
-    /// smaller radius (0 before the first step; the guard stops a run beyond `[guard] overlap`).
-    fn deepest_overlap(&self) -> f64;
-    /// Largest excess of a contact's energy account in any step run so far, as a fraction of
-    /// the energy the contact took (0 when none gave out more than it took; the guard stops a
-    /// run beyond `[guard] contact`).
-    fn largest_excess(&self) -> f64;
-    /// The ledgers read at the current step ([`Reading`]; the forces of the step evaluated):
-    /// the energy and momentum flows accumulated over every step run so far, and the state's
-    /// energies and free momentum. Two readings give the ledgers of the steps between them.
-    fn ledger(&self) -> Reading;
-    /// The ledgers' flows accumulated over every step run so far (those of [`Engine::ledger`]).
-    fn flows(&self) -> Flows;
-    /// Sets the accumulated flows: a run resumed from a checkpoint continues those of the run
-    /// that wrote it.
-    fn set_flows(&mut self, flows: Flows);
-    /// Advances `steps` time steps (evaluating the initial forces first if needed). Stops early,
-    /// with the reason, when the run guard finds a number that cannot be trusted; after that
-    /// every call fails the same way.
-    fn advance(&mut self, steps: u64) -> Result<(), Failure>;
-}
+/// Steps of a window of the run guard's energy balance: short enough that a slow instability is
+/// stopped long before a save of the benchmark (every 50000 steps), long enough that measuring
+/// the energy (a pass over the particles and the pairs) and starting the team of threads again
+/// cost nothing against the steps; `verdem run` advances in blocks of this length anyway.
+pub const ENERGY_WINDOW: u64 = 2000;
 
-impl<L: ContactLaw> Engine for Simulation<L> {
-    fn state(&self) -> &State {
-        &self.core.state
-    }
-    fn params(&self) -> &Params {
-        &self.core.params
-    }
-    fn params_mut(&mut self) -> &mut Params {
-        self.core.energy_at = None;
-        &mut self.core.params
-    }
-    fn counters(&self) -> &StageTimes {
-        &self.core.counters
-    }
-    fn counters_mut(&mut self) -> &mut StageTimes {
-        &mut self.core.counters
-    }
-    fn snapshot(&self) -> Snapshot {
-        self.core.snapshot()
-    }
-    fn contact_sample(&self) -> Vec<SampledContact> {
-        self.core.contact_sample()
-    }
-    fn sample_contacts_every(&mut self, every: u64) {
-        self.core.params.contact_every = every;
-    }
-    fn take_contact_samples(&mut self) -> Vec<(u64, Vec<SampledContact>)> {
-        std::mem::take(&mut self.core.contact_samples)
-    }
-    fn restore(&mut self, snap: &Snapshot) {
-        self.core.restore(snap)
-    }
-    fn history_words(&self) -> usize {
-        <L::History as History>::WORDS
-    }
-    fn rebuild(&mut self) {
-        self.rebuild_booked()
-    }
-    fn contact_count(&self) -> usize {
-        self.core.contact_count()
-    }
-    fn pair_count(&self) -> usize {
-        self.core.pair_count()
-    }
-    fn deepest_overlap(&self) -> f64 {
-        self.core.deepest
-    }
-    fn largest_excess(&self) -> f64 {
-        self.core.pumped
-    }
-    fn ledger(&self) -> Reading {
-        let c = &self.core;
-        let s = &c.state;
-        energy::read(
-            &self.law,
-            &s.particles,
-            &s.domain,
-            c.params.gravity,
-            &c.pairs,
-            (s.step, c.params.dt, c.flows),
-        )
-    }
-    fn flows(&self) -> Flows {
-        self.core.flows
-    }
-    fn set_flows(&mut self, flows: Flows) {
-        self.core.flows = flows;
-    }
-    fn advance(&mut self, steps: u64) -> Result<(), Failure> {
+impl<L: ContactLaw> Simulation<L> {
+    /// [`Engine::advance`]: the initial forces if needed, then `steps` steps in windows of
+    /// [`ENERGY_WINDOW`], each closed by the run guard's energy balance.
+    fn advance_in_windows(&mut self, steps: u64) -> Result<(), Failure> {
         if self.core.failure.is_none() && !self.core.state.forces_ready {
             // The state given is checked before its forces are evaluated and saved, so that no
             // save or diagnostics row is made of velocities the guard would refuse.
@@ -224,15 +112,7 @@ impl<L: ContactLaw> Engine for Simulation<L> {
         }
         self.core.failure.clone().map_or(Ok(()), Err)
     }
-}
 
-/// Steps of a window of the run guard's energy balance: short enough that a slow instability is
-/// stopped long before a save of the benchmark (every 50000 steps), long enough that measuring
-/// the energy (a pass over the particles and the pairs) and starting the team of threads again
-/// cost nothing against the steps; `verdem run` advances in blocks of this length anyway.
-pub const ENERGY_WINDOW: u64 = 2000;
-
-impl<L: ContactLaw> Simulation<L> {
     /// The mechanical energy of the current state ([`energy::measure`]).
     fn energy(&self) -> energy::Energy {
         let c = &self.core;
@@ -346,84 +226,28 @@ impl<L: ContactLaw> Simulation<L> {
         if steps == 0 {
             return 0;
         }
-        let core = &mut self.core;
         // The run guard: velocities set since the last run are checked once here; within the
         // run only contact forces can make them otherwise, and those are checked.
-        if let Some(b) = guard::not_finite(&core.state.particles) {
-            let state = &core.state;
-            core.failure = Some(b.report(state.step, state.time, &state.id));
+        if let Some(b) = guard::not_finite(&self.core.state.particles) {
+            let state = &self.core.state;
+            self.core.failure = Some(b.report(state.step, state.time, &state.id));
             return 0;
         }
-        let threads = core.params.threads;
-        let chunks = core.work.plan.chunks(core.state.particles.len());
-        let bound = core.work.moved_bound;
-        let skin = core.work.builder.skin;
-        core.work.plan.reset_live();
-        let domain = core.state.domain.clone();
-        let params = &core.params;
-        let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
-        let (contact_every, first_step) = (params.contact_every, core.state.step);
-        let guard = params.guard;
-        let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
-        let periodic_gravity = params
-            .gravity
-            .map(|g| energy::periodic_part(g, &domain))
-            .filter(|g| *g != Vec3::zeros());
-        let mut list = core.list_state();
-        let arrays = Shared::new(Arrays::of(&mut list));
-        let team = Team {
-            threads,
-            bind: bind && threads > 1,
-            barrier: SpinBarrier::new(threads),
-            speeds: (0..threads)
-                .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
-                .collect(),
-            particle_queue: WorkQueue::new(threads, chunks),
-            pair_queue: WorkQueue::new(threads, chunks),
-            pairs_done: Marks::new(chunks),
-            rebuild_queue: WorkQueue::new(threads, chunks),
-            list: Shared::new(list),
-            arrays,
-            meet,
-            law: &self.law,
-            guard,
-            alarm: Alarm::default(),
-            kick: Kick {
-                domain: &domain,
-                dt,
-                gravity,
-                periodic_gravity,
-            },
-            skin,
-            contact_every,
-            first_step,
-        };
-        let work_of = |tid: usize| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps);
-        let done = if threads == 1 {
-            work_of(0)
-        } else {
-            std::thread::scope(|s| {
-                let handles: Vec<_> = (1..threads)
-                    .map(|tid| {
-                        let work_of = &work_of;
-                        s.spawn(move || work_of(tid))
-                    })
-                    .collect();
-                let mut mine = work_of(0);
-                for h in handles {
-                    let theirs = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-                    // an integer sum: the same in any order of the threads
-                    mine.supplied += theirs.supplied;
-                    mine.flows.add(&theirs.flows);
-                    mine.deepest = mine.deepest.max(theirs.deepest);
-                    mine.pumped = mine.pumped.max(theirs.pumped);
-                    mine.samples.extend(theirs.samples);
-                }
-                mine
-            })
-        };
+        let bound = self.core.work.moved_bound;
+        let domain = self.core.state.domain.clone();
+        let team = Team::new(&mut self.core, &self.law, &domain);
+        let done =
+            team.on_every_thread(|tid| Worker::new(&team, tid, bound).run::<ROT, GRAV>(steps));
         let breach = team.alarm.take();
+        self.close_run(done, breach)
+    }
+
+    /// Books what the threads of a run left (`done`, merged) into the core: counters, bounds,
+    /// the steps and time reached, the ledgers' flows, and the run guard's first breach as the
+    /// simulation's failure. Returns the work supplied, as [`Simulation::run`] does.
+    fn close_run(&mut self, done: Done, breach: Option<(u64, guard::Breach)>) -> i128 {
         let core = &mut self.core;
+        let dt = core.params.dt;
         core.counters.add_times(&done.times);
         core.counters.rebuilds += done.times.rebuilds;
         core.work.moved_bound = done.bound;
@@ -464,6 +288,18 @@ struct Done {
     samples: Vec<(u64, Vec<SampledContact>)>,
 }
 
+impl Done {
+    /// Adds what another thread of the same run left.
+    fn merge(&mut self, theirs: Done) {
+        // an integer sum: the same in any order of the threads
+        self.supplied += theirs.supplied;
+        self.flows.add(&theirs.flows);
+        self.deepest = self.deepest.max(theirs.deepest);
+        self.pumped = self.pumped.max(theirs.pumped);
+        self.samples.extend(theirs.samples);
+    }
+}
+
 /// What the threads of a run share.
 struct Team<'a, L: ContactLaw> {
     threads: usize,
@@ -491,6 +327,78 @@ struct Team<'a, L: ContactLaw> {
     contact_every: u64,
     /// The step the run starts from.
     first_step: u64,
+}
+
+impl<'a, L: ContactLaw> Team<'a, L> {
+    /// The team of a run of `core` under `law` in the box `domain` (the state's, borrowed for
+    /// the run): `core.params.threads` threads, work queues of the chunks of the current plan
+    /// (their live ends reset), the shared views of the arrays, and the step's parameters.
+    fn new(core: &'a mut Core<L::History>, law: &'a L, domain: &'a Domain) -> Self {
+        let threads = core.params.threads;
+        let chunks = core.work.plan.chunks(core.state.particles.len());
+        let skin = core.work.builder.skin;
+        core.work.plan.reset_live();
+        let params = &core.params;
+        let (dt, meet, bind) = (params.dt, params.meet.clone(), params.bind);
+        let (contact_every, first_step) = (params.contact_every, core.state.step);
+        let guard = params.guard;
+        let gravity = params.gravity.unwrap_or_else(Vec3::zeros);
+        let periodic_gravity = params
+            .gravity
+            .map(|g| energy::periodic_part(g, domain))
+            .filter(|g| *g != Vec3::zeros());
+        let mut list = core.list_state();
+        let arrays = Shared::new(Arrays::of(&mut list));
+        Team {
+            threads,
+            bind: bind && threads > 1,
+            barrier: SpinBarrier::new(threads),
+            speeds: (0..threads)
+                .map(|_| std::array::from_fn(|_| [AtomicU64::new(0), AtomicU64::new(0)]))
+                .collect(),
+            particle_queue: WorkQueue::new(threads, chunks),
+            pair_queue: WorkQueue::new(threads, chunks),
+            pairs_done: Marks::new(chunks),
+            rebuild_queue: WorkQueue::new(threads, chunks),
+            list: Shared::new(list),
+            arrays,
+            meet,
+            law,
+            guard,
+            alarm: Alarm::default(),
+            kick: Kick {
+                domain,
+                dt,
+                gravity,
+                periodic_gravity,
+            },
+            skin,
+            contact_every,
+            first_step,
+        }
+    }
+
+    /// Runs `work_of(tid)` on every thread of the team, thread 0 on this one and the others
+    /// spawned for the run, and merges what they leave in thread order ([`Done::merge`]). A
+    /// thread's panic is resumed here.
+    fn on_every_thread(&self, work_of: impl Fn(usize) -> Done + Sync) -> Done {
+        if self.threads == 1 {
+            return work_of(0);
+        }
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (1..self.threads)
+                .map(|tid| {
+                    let work_of = &work_of;
+                    s.spawn(move || work_of(tid))
+                })
+                .collect();
+            let mut mine = work_of(0);
+            for h in handles {
+                mine.merge(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+            }
+            mine
+        })
+    }
 }
 
 /// One thread of a run: its share of every stage, and its own counters.
@@ -778,9 +686,9 @@ mod tests {
     use super::{Core, Simulation};
     use crate::case::Case;
     use crate::contact::ContactLaw;
-    use crate::engine::{self, LawVisitor};
     use crate::neighbor::NeighborBuilder;
-    use crate::scene::Scene;
+    use crate::step::engine::Scene;
+    use crate::step::engine::{self, LawVisitor};
     use std::path::Path;
 
     /// Runs `steps` steps of the scene on one thread under the case's law, then checks the

@@ -8,7 +8,7 @@
 use super::{row, Row};
 use crate::analysis::stats::slope;
 use crate::case::{Case, Scene};
-use crate::engine::{self, Overrides};
+use crate::step::engine::{self, Overrides};
 use crate::Vec3;
 
 /// Closed-form collision of the linear spring–dashpot for effective mass `meff`.

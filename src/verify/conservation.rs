@@ -19,11 +19,11 @@
 
 use super::{row_abs, Row};
 use crate::case::{Case, Tangential};
-use crate::engine::{self, Overrides};
 use crate::scene::{self, random_velocities, Scene};
 use crate::state::Domain;
 use crate::state::Snapshot;
 use crate::state::{Motion, Particles};
+use crate::step::engine::{self, Overrides};
 use crate::Vec3;
 
 /// Energy, momentum and angular momentum (about the origin) of a snapshot. The energy is the

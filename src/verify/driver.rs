@@ -1,6 +1,6 @@
 //! The seam through which every prescribed-motion case drives its contact: a [`MotionDriver`]
 //! turns a case (two spheres and a contact law) and a motion into the forces and torques at
-//! every row, in the conventions of [`crate::kinematics`] (lab frame, n from sphere 1 to
+//! every row, in the conventions of [`crate::verify::kinematics`] (lab frame, n from sphere 1 to
 //! sphere 2, torques about each sphere's centre, row k from row k's motion). [`Own`] is
 //! verdem's law; [`External`] runs another program through files, with the interface of
 //! `verdem kinematics` (`docs/code-interface.md`).
@@ -15,7 +15,7 @@ use anyhow::Context;
 use crate::case::Case;
 use crate::child::{self, OnParentDeath};
 use crate::io::{self, atomic};
-use crate::kinematics::{self, ForceRow, Increment, MotionRow};
+use crate::verify::kinematics::{self, ForceRow, Increment, MotionRow};
 
 /// Something that drives one contact of two spheres through a prescribed motion.
 pub trait MotionDriver {

@@ -14,7 +14,7 @@
 use super::objectivity::{spin_sphere_2, tangent_axis};
 use super::{row, row_abs, Row, Subject};
 use crate::case::Case;
-use crate::kinematics::{pair_of, ForceRow, MotionRow};
+use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// The histories, by their names in the table.

@@ -28,7 +28,7 @@ use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
 use super::ratchet::net_work;
 use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{pair_of, MotionRow};
+use crate::verify::kinematics::{pair_of, MotionRow};
 use crate::Vec3;
 
 /// Steps of each leg of the cycle.

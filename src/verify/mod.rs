@@ -20,6 +20,7 @@ pub mod conservation;
 pub mod driver;
 pub mod extremes;
 pub mod histories;
+pub mod kinematics;
 pub mod mcnamara;
 pub mod objectivity;
 pub mod oblique;
@@ -31,7 +32,6 @@ use crate::analysis::verdict::Outcome;
 use crate::analysis::{Limit, Verdict};
 use crate::case::{Case, Tangential, COARSE_STEPS_PER_COLLISION};
 use crate::contact::registry::Properties;
-use crate::kinematics;
 pub use collision::{binary_collisions, closed_form, collide, ClosedForm, Measured};
 use driver::{MotionDriver, OWN};
 

@@ -15,7 +15,7 @@ use nalgebra::{Rotation3, Unit, UnitQuaternion};
 use super::driver::MotionDriver;
 use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{pair_of, ForceRow, MotionRow};
+use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Steps of the rigid rotation per radian.

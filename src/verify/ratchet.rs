@@ -20,7 +20,7 @@ use super::driver::MotionDriver;
 use super::objectivity::{rigid_rotation, tangent_axis};
 use super::{row_abs, Row, Subject};
 use crate::case::{Case, Tangential};
-use crate::kinematics::{pair_of, ForceRow, MotionRow};
+use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// Appends `steps` rows translating sphere 2 around sphere 1's centre about `axis` by `angle`,

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use verdem::case::Case;
-use verdem::engine::{self, Overrides};
 use verdem::scene;
+use verdem::step::engine::{self, Overrides};
 use verdem::step::Engine;
 
 /// The repository root.

@@ -28,7 +28,7 @@ pub mod timestep;
 use std::path::{Path, PathBuf};
 
 use crate::case::Case;
-use crate::engine::{self, Overrides};
+use crate::step::engine::{self, Overrides};
 use crate::step::guard::Failure;
 use crate::step::Engine;
 

@@ -1,5 +1,7 @@
 //! Scenes: the bumpy-wall shear geometry (generated or read from a file) and explicit sphere
-//! lists.
+//! lists; [`tile`], the benchmark cell tiled for timing against system size.
+
+pub mod tile;
 
 use std::path::Path;
 
@@ -12,15 +14,8 @@ use crate::io::{mercury, official};
 use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::Domain;
 use crate::state::{memory, Motion, Particles};
+pub use crate::step::engine::Scene;
 use crate::Vec3;
-
-/// The initial state of a run.
-pub struct Scene {
-    pub domain: Domain,
-    pub particles: Particles,
-    /// Start time (that of the `.data` file it was read from, else 0).
-    pub time: f64,
-}
 
 /// The box of a case.
 pub fn domain_of(case: &Case) -> Domain {

@@ -33,10 +33,10 @@ use crate::analysis::difference::{CoreMean, Difference};
 use crate::analysis::inrun::{self, Inrun};
 use crate::analysis::stats::standard_error;
 use crate::case::{Case, Scene};
-use crate::engine::{self, Overrides};
 use crate::ensemble::{perturb, replica_seed};
 use crate::io::atomic;
 use crate::run::{self, Observer, RunOptions};
+use crate::step::engine::{self, Overrides};
 use crate::verify::{closed_form, collide};
 
 /// One variant of the reference case.

@@ -14,8 +14,8 @@ use nalgebra::{Quaternion, UnitQuaternion};
 
 use crate::case::{Case, Scene, COARSE_STEPS_PER_COLLISION};
 use crate::contact::{ContactLaw, PairForce, PairInput, PairKinematics};
-use crate::engine::{self, LawVisitor};
 use crate::io::FormatError;
+use crate::step::engine::{self, LawVisitor};
 use crate::Vec3;
 
 /// The columns of a motion file, in order.
@@ -517,7 +517,11 @@ mod tests {
 
     #[test]
     fn forces_csv_round_trips_and_errors_name_line_and_column() {
-        let case = Case::parse(include_str!("../cases/verify/objectivity.toml"), "o.toml").unwrap();
+        let case = Case::parse(
+            include_str!("../../cases/verify/objectivity.toml"),
+            "o.toml",
+        )
+        .unwrap();
         let mut rows = vec![still(0.0, 1e-3)];
         rows.push(MotionRow {
             t: 1e-4,
@@ -579,7 +583,7 @@ mod tests {
     #[test]
     fn static_overlap_gives_kn_delta_on_sphere_2_along_n_and_nothing_apart() {
         let case = Case::parse(
-            include_str!("../cases/verify/binary_collision.toml"),
+            include_str!("../../cases/verify/binary_collision.toml"),
             "b.toml",
         )
         .unwrap();
