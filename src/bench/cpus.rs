@@ -15,8 +15,8 @@ use crate::team::{allowed_cpus, Bound};
 struct Line(AtomicU64);
 
 /// Hand-overs of the core-to-core probe before and after each run on two or more CPUs: few
-/// enough that the probe takes milliseconds beside a run of seconds, enough that five batches
-/// each average a thousand hand-overs or more (what it took: `docs/performance.md`).
+/// enough that the probe takes milliseconds beside a run of seconds, enough that each of its
+/// five batches averages 4000 (what it took: `docs/performance.md`).
 pub(super) const PROBE_TRIPS: u64 = 20_000;
 
 /// The probes of a bench fall into placements of the two CPUs: sorted, they are cut wherever
@@ -28,7 +28,7 @@ const PLACEMENT_GAP: f64 = 1.5;
 /// The placements of the two CPUs that the probes `probes` (ns) show: the probes sorted and cut
 /// at every gap of more than [`PLACEMENT_GAP`]×, each group as its lowest and highest probe,
 /// nearest first; empty without probes.
-pub(super) fn placements(probes: &[f64]) -> Vec<(f64, f64)> {
+fn placements(probes: &[f64]) -> Vec<(f64, f64)> {
     let mut p: Vec<f64> = probes
         .iter()
         .copied()
@@ -48,7 +48,7 @@ pub(super) fn placements(probes: &[f64]) -> Vec<(f64, f64)> {
 /// The placement (an index into `groups`, [`placements`]) of a run whose probes before and
 /// after are `probes`: `None` when they fall in different groups (the host moved a CPU during
 /// the run) or in none.
-pub(super) fn placed(groups: &[(f64, f64)], probes: [f64; 2]) -> Option<usize> {
+fn placed(groups: &[(f64, f64)], probes: [f64; 2]) -> Option<usize> {
     let group = |p: f64| groups.iter().position(|(lo, hi)| (*lo..=*hi).contains(&p));
     match (group(probes[0]), group(probes[1])) {
         (Some(a), Some(b)) if a == b => Some(a),

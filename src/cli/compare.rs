@@ -49,18 +49,16 @@ pub const CHI2_LIMIT: f64 = 3.0;
 const NO_ERROR_BARS: &str =
     "no error bars in either table: without them no difference can be told from noise";
 
-/// The report `suite` of each profile of [`FIELDS`] of `table` against the reference
-/// `reference` in `chi2` (χ²/dof) and `rel_mean` (difference of the core means relative to the
-/// reference's): judged [`CHI2_LIMIT`], grouped by `table`, each case's word `PASS`, `FAIL` or
-/// `undefined`, and `extra` (name, value) added to the details of the profile of index
-/// `extra_of`.
+/// The cases of the report `suite` for each profile of [`FIELDS`] of the table `table` against
+/// the reference `reference`, from its χ²/dof `chi2` and, where known, the differences of the
+/// core means relative to the reference's `rel_mean`: judged below [`CHI2_LIMIT`], grouped by
+/// `table`, each case's word `PASS`, `FAIL` or `undefined` (no error bars: skipped).
 pub fn profile_cases(
     suite: &str,
     table: &str,
     reference: &str,
     chi2: &[f64; 5],
     rel_mean: Option<&[f64; 5]>,
-    extra: (usize, Vec<Detail>),
 ) -> Vec<Case> {
     FIELDS
         .iter()
@@ -87,9 +85,6 @@ pub fn profile_cases(
             if let Some(rel) = rel_mean {
                 details.push(Detail::new("relative_core_mean_difference", rel[f], ""));
             }
-            if f == extra.0 {
-                details.extend(extra.1.iter().cloned());
-            }
             Case::skipped_because(suite, &v, word, why)
                 .undefined_because(NO_ERROR_BARS)
                 .with_details(details)
@@ -102,28 +97,22 @@ pub fn profile_cases(
 /// offset and that offset.
 fn report(reference: &str, rows: &[Comparison]) -> Report {
     let suite = "verdem compare";
-    let vx = FIELDS.iter().position(|(n, _)| *n == "vx").unwrap_or(0);
-    let cases = rows
-        .iter()
-        .flat_map(|r| {
-            let shape = vec![
+    let vx = FIELDS.iter().position(|(n, _)| *n == "vx");
+    let mut cases = Vec::new();
+    for r in rows {
+        let mut own = profile_cases(suite, &r.name, reference, &r.chi2, Some(&r.rel_mean));
+        if let Some(c) = vx.map(|f| &mut own[f]) {
+            c.details.extend([
                 Detail::new(
                     "chi2_per_dof_less_offset",
                     r.vx_shape.chi2,
                     "fewer than two slices with an error bar",
                 ),
                 Detail::new("offset", r.vx_shape.offset, "no slice with an error bar"),
-            ];
-            profile_cases(
-                suite,
-                &r.name,
-                reference,
-                &r.chi2,
-                Some(&r.rel_mean),
-                (vx, shape),
-            )
-        })
-        .collect();
+            ]);
+        }
+        cases.extend(own);
+    }
     Report::of_cases(suite, cases)
 }
 

@@ -110,12 +110,7 @@ fn report(r: &cross::Report) -> Report {
     let profiles = format!("{peer} profiles");
     match r.profiles_chi2 {
         Some(chi2) => cases.extend(super::compare::profile_cases(
-            suite,
-            &profiles,
-            "verdem",
-            &chi2,
-            None,
-            (usize::MAX, Vec::new()),
+            suite, &profiles, "verdem", &chi2, None,
         )),
         None => {
             let why = format!("{peer} gives no per-contact forces, so its stresses are unknown");
