@@ -39,8 +39,9 @@ pub const TRACE_SAMPLES: usize = 200_000;
 /// Free–free contact durations tc between two contact-stress samples. A contact's force is a
 /// pulse of duration tc, so the contact stress decorrelates within ~tc (a half sine gives an
 /// integrated autocorrelation time 4tc/π²) and samples 8 tc apart are independent; closer
-/// samples would carry more information per step, but each costs a snapshot of the engine and a
-/// stop of the run loop, which at 8 tc stays within 3 % of the step (docs/statistics.md).
+/// samples would carry more information per step, but each costs the engine a sample inside its
+/// step, which at 8 tc stays a small fraction of the step's cost (docs/statistics.md; measured:
+/// docs/performance.md).
 pub const CONTACTS_PER_SAMPLE: f64 = 8.0;
 
 /// Contact durations between two samples of the particle fields: they change on the time
@@ -758,8 +759,8 @@ pub fn errors_csv(r: &InrunResult) -> String {
 }
 
 /// Per benchmark profile of [`FIELDS`], the core mean and its own standard error in an error
-/// table written by [`errors_csv`]; `None` when the table has no core columns (written before
-/// they were added, 2026-11-25). A missing row, or a core mean or error that is not a finite
+/// table written by [`errors_csv`]; `None` when the table has no core columns (an error table
+/// written by a verdem older than those columns). A missing row, or a core mean or error that is not a finite
 /// number, is refused, naming the file, the line and the field.
 pub fn read_core_means(path: &Path) -> Result<Option<Vec<(f64, f64)>>, FormatError> {
     let (file, text) = read_text(path)?;

@@ -4,7 +4,9 @@
 //! A verdict maps to a test case's status so that a JUnit reader fails the build exactly when
 //! the command exits with its checks failed: a passed verdict passes, a gating failure (an ERROR
 //! row included) fails, and everything that does not gate is skipped with the reason — a FAIL*
-//! row (a peer convention's known defect), an undecided verdict, a value reported only.
+//! row (a peer convention's known defect), an undecided verdict, a value reported only. Where a
+//! command's judgements are a report only (`cg`, `run`, `compare`, `cross`, `bench`'s goals),
+//! its exit status stays 0 while a case that misses its limit is a failure in the report.
 //!
 //! Numbers are finite only: a non-finite value is `null` in the JSON and the word `undefined`
 //! in the messages, so that neither file holds the token NaN or inf (which
@@ -47,6 +49,34 @@ pub struct Case {
     pub limit: &'static str,
     /// Expected, measured and tolerance in words, and for a skipped case why it is skipped.
     pub message: String,
+    /// Why `measured` is `None`, where the report says (the field is absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub undefined: Option<String>,
+    /// The row's other numbers (a comparison's difference of the core means, a save's spreads,
+    /// …), in the order its text table gives them; the field is absent when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub details: Vec<Detail>,
+}
+
+/// One more number of a row: its name, its value (`None` when it is not a finite number) and,
+/// for `None`, why.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Detail {
+    pub name: String,
+    pub value: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub undefined: Option<String>,
+}
+
+impl Detail {
+    /// `value` named `name`; when it is not finite, `None` and the reason `undefined`.
+    pub fn new(name: &str, value: f64, undefined: &str) -> Detail {
+        Detail {
+            name: name.into(),
+            value: finite(value),
+            undefined: (!value.is_finite()).then(|| undefined.into()),
+        }
+    }
 }
 
 /// A suite of test cases: one command's verdicts.
@@ -100,6 +130,12 @@ impl Case {
     /// verdict's words instead of the numbers where it has them), then, when skipped, the
     /// reason.
     pub fn of(suite: &str, v: &Verdict, result: &str) -> Case {
+        Case::skipped_because(suite, v, result, None)
+    }
+
+    /// As [`Case::of`], but a case that is skipped says `reason` for it (when given) instead of
+    /// the reason its outcome gives.
+    pub fn skipped_because(suite: &str, v: &Verdict, result: &str, reason: Option<&str>) -> Case {
         let (limit, tolerance) = match v.limit {
             Limit::Relative { tolerance, .. } => ("relative", Some(tolerance)),
             Limit::Absolute { tolerance, .. } => ("absolute", Some(tolerance)),
@@ -133,24 +169,22 @@ impl Case {
         if !v.measured.is_finite() && v.limit != Limit::None {
             message.push_str(" (the measured value is not a finite number)");
         }
-        let status = match (v.outcome, v.gate) {
-            (Outcome::Pass, _) => Status::Passed,
-            (Outcome::Fail, true) => Status::Failed,
-            (Outcome::Fail, false) => {
-                message.push_str(
-                    "; skipped: a known defect of a peer convention, shown but not gating",
-                );
-                Status::Skipped
-            }
-            (Outcome::Undecided, _) => {
-                message.push_str("; skipped: undecided, the uncertainty covers the limit");
-                Status::Skipped
-            }
-            (Outcome::Reported, _) => {
-                message.push_str("; skipped: reported for information, not judged");
-                Status::Skipped
-            }
+        let (status, why) = match (v.outcome, v.gate) {
+            (Outcome::Pass, _) => (Status::Passed, ""),
+            (Outcome::Fail, true) => (Status::Failed, ""),
+            (Outcome::Fail, false) => (
+                Status::Skipped,
+                "a known defect of a peer convention, shown but not gating",
+            ),
+            (Outcome::Undecided, _) => (
+                Status::Skipped,
+                "undecided, the uncertainty covers the limit",
+            ),
+            (Outcome::Reported, _) => (Status::Skipped, "reported for information, not judged"),
         };
+        if status == Status::Skipped {
+            message.push_str(&format!("; skipped: {}", reason.unwrap_or(why)));
+        }
         Case {
             group: if v.case.is_empty() {
                 suite.into()
@@ -165,7 +199,23 @@ impl Case {
             tolerance,
             limit,
             message,
+            undefined: None,
+            details: Vec::new(),
         }
+    }
+
+    /// The same case, saying why its measured value is undefined when it is.
+    pub fn undefined_because(mut self, reason: &str) -> Case {
+        if self.measured.is_none() {
+            self.undefined = Some(reason.into());
+        }
+        self
+    }
+
+    /// The same case with the row's other numbers `details`.
+    pub fn with_details(mut self, details: Vec<Detail>) -> Case {
+        self.details = details;
+        self
     }
 }
 
@@ -173,10 +223,15 @@ impl Report {
     /// The suite `suite` of `verdicts`, each with the word `result` gives it in the command's
     /// text table, in their order.
     pub fn new(suite: &str, verdicts: &[Verdict], result: impl Fn(&Verdict) -> String) -> Report {
-        let cases: Vec<Case> = verdicts
+        let cases = verdicts
             .iter()
             .map(|v| Case::of(suite, v, &result(v)))
             .collect();
+        Report::of_cases(suite, cases)
+    }
+
+    /// The suite `suite` of `cases`, in their order.
+    pub fn of_cases(suite: &str, cases: Vec<Case>) -> Report {
         let count = |s| cases.iter().filter(|c| c.status == s).count();
         Report {
             suite: suite.into(),
@@ -236,7 +291,7 @@ impl Report {
 
     /// The report as a JSON object: `suite`, the counts `tests`, `passed`, `failures`,
     /// `skipped`, and `cases`, an array of objects with the fields of [`Case`] (numbers that are
-    /// not finite are `null`).
+    /// not finite are `null`; `undefined` and `details` only where a report gives them).
     pub fn json(&self) -> String {
         let mut s = serde_json::to_string_pretty(self).expect("a report serialises");
         s.push('\n');

@@ -68,12 +68,20 @@ pub struct Args {
     out: PathBuf,
     /// Draw a sweep's cost plot again from its `bench.csv` (a recorded sweep's, say), into the
     /// PNG of the same name beside it, and time nothing.
-    #[arg(long, value_name = "BENCH_CSV", conflicts_with_all = ["scale", "probe"])]
+    #[arg(long, value_name = "BENCH_CSV", conflicts_with_all = ["scale", "probe", "junit", "json"])]
     plot: Option<PathBuf>,
     /// Run one configuration (`verdem:THREADS` or `PEER:NP`) once and print its peak resident
     /// memory: the child process a sweep measures memory with.
     #[arg(long, hide = true)]
     probe: Option<String>,
+    /// Also write the goals the tables judge as a JUnit XML report to this file: one test case
+    /// per goal, its goal, median and interval in the message; a goal not met is a failure, an
+    /// undecided one is skipped with the reason (the exit status stays 0).
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// Also write the goals as a JSON table to this file (docs/cli.md, "Reports for CI").
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -135,8 +143,10 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         + &bench::markdown(&measured, particles);
     print!("{md}");
     atomic::write(&a.out.join("bench.md"), md.as_bytes())?;
+    let goals = bench::goals(&measured, particles);
     let at = AtSize::without_memory(particles, a.steps, measured);
     atomic::write(&a.out.join("bench.csv"), bench::csv(&[at]).as_bytes())?;
+    write_goals(&a, &goals)?;
     Ok(Finished::Done)
 }
 
@@ -172,7 +182,16 @@ fn sweep(a: &Args, case_path: &Path, configs: &[Config]) -> anyhow::Result<Finis
     atomic::write(&a.out.join("bench.md"), md.as_bytes())?;
     atomic::write(&a.out.join("bench.csv"), bench::csv(&measured).as_bytes())?;
     bench::cost_png(&measured, &a.out.join("bench.png"))?;
+    write_goals(a, &bench::sweep_goals(&measured))?;
     Ok(Finished::Done)
+}
+
+/// Writes the goals `goals` to the reports `--junit` and `--json` ask for ([`bench::report`]).
+fn write_goals(a: &Args, goals: &[bench::Goal]) -> anyhow::Result<()> {
+    if a.junit.is_some() || a.json.is_some() {
+        bench::report("verdem bench", goals).write(a.junit.as_deref(), a.json.as_deref())?;
+    }
+    Ok(())
 }
 
 /// What a sweep timed, how, and on what.
