@@ -13,8 +13,8 @@ use anyhow::Context;
 use super::cpus::{round_trip_ns, PROBE_TRIPS};
 use crate::analysis::stats::median;
 use crate::case::Case;
-use crate::engine::{self, Overrides};
 use crate::peers::Peer;
+use crate::step::engine::{self, Overrides};
 use crate::step::StageTimes;
 use crate::team::{Bound, SpinBarrier};
 
