@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use verdem::case::{Case, Tangential};
+use verdem::contact::named;
+use verdem::contact::Tangential;
 use verdem::peers::{cross, Peer};
 use verdem::run;
 
@@ -60,7 +61,7 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(&a.case)?;
+    let case = named::load(&a.case)?;
     let out = a.out.join(a.peer.binary());
     let lock = lock_output_folder(&out)?;
     for series in [a.peer.binary(), "verdem"] {

@@ -3,7 +3,8 @@
 //! units.
 
 use super::lammps_family::{boundary, neighbor, Dialect, GROUPS};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::state::Snapshot;
 use crate::Vec3;
 

@@ -21,8 +21,9 @@ pub mod dump;
 
 use super::inrun::WALLS_FILE;
 use super::{placed_contacts, wall_speeds, Frame, Installed, Naming, Peer, Program, MPIRUN};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::io::atomic;
 use crate::state::Motion;
 use crate::state::{Contact, Snapshot};

@@ -2,7 +2,8 @@
 //! tangential history absolute_damping on`, in SI units; coefficients per pair of atom types.
 
 use super::lammps_family::{boundary, neighbor, Dialect, DUMP_COLUMNS, GROUPS};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::state::Snapshot;
 use crate::Vec3;
 

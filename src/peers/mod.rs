@@ -24,8 +24,9 @@ pub mod liggghts;
 pub mod motion;
 pub mod yade;
 
-use crate::case::{Case, Scene, Tangential};
+use crate::case::{Case, Scene};
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::state::{Contact, PairForce, Snapshot};
 use crate::Vec3;
 

@@ -17,7 +17,8 @@
 //! tangential force may arise, and the final tangential velocities are zero.
 
 use super::{closed_form, row, row_abs, Row};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::collision::{impact, Body, Outcome};
 use crate::Vec3;
 
@@ -91,7 +92,7 @@ pub fn rows_against(reference: &Case, simulated: &Case) -> anyhow::Result<Vec<Ro
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
         let mut unclipped = simulated.clone();
-        unclipped.contact.tangential = conv;
+        unclipped.contact.tangential = conv.into();
         unclipped.contact.clip_normal = false;
         let mut clipped = unclipped.clone();
         clipped.contact.clip_normal = true;
