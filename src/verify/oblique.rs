@@ -55,18 +55,20 @@ fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64
 }
 
 /// Relative tolerance of Jt/Jn = μ: the contact sticks in its first and last steps, where the
-/// spring has not reached the cap, an O(dt) shortfall of measured ≤ 1.9e-5 at tc/50; 5 times
-/// that, below the 1e-3 of a law whose μ is 0.1 % off.
+/// spring has not reached the cap, an O(dt) shortfall (measured at tc/50 in
+/// `docs/verification.md`, "Tolerances"); 5 times that, below the 1e-3 of a law whose μ is
+/// 0.1 % off.
 const MU_TOLERANCE: f64 = 1e-4;
 
 /// Absolute tolerance of β = e while sticking: the scheme's first-order error in e (8e-4 at
 /// tc/50, free–wall) plus the effect of the lever arm R − δ/2 and of the wall sphere's
-/// curvature on the tangential oscillator, O(δmax/R) = 3e-3; measured ≤ 1.8e-3.
+/// curvature on the tangential oscillator, O(δmax/R) = 3e-3 (the error measured is in
+/// `docs/verification.md`, "Tolerances").
 const STICK_TOLERANCE: f64 = 4e-3;
 
 /// Absolute tolerance of β = 7μ(1 + e)/(2ψ) − 1 while sliding: the first-order error of the
-/// clipped e (1.8e-4 relative at tc/50) and the sticking first and last steps; measured
-/// ≤ 4.5e-4.
+/// clipped e (1.8e-4 relative at tc/50) and the sticking first and last steps (the error
+/// measured is in `docs/verification.md`, "Tolerances").
 const SLIDE_TOLERANCE: f64 = 2e-3;
 
 /// The oblique-impact rows of every tangential convention for the case `base` (whose law must
@@ -177,7 +179,7 @@ fn opposite_spins(case: &Case) -> anyhow::Result<Vec<Row>> {
         .norm()
         .max((out.w[1] - Vec3::new(0.0, 0.0, -10.0)).norm());
     let name = format!("opposite spins {}", case.contact.tangential.name());
-    // mirror images: every tangential force and torque cancels exactly (measured 0)
+    // mirror images: every tangential force and torque cancels exactly
     Ok(vec![
         row_abs(&name, "final tangential speed = 0", 0.0, tangential, 1e-12),
         row_abs(&name, "spin change = 0", 0.0, spin_change, 1e-10),
