@@ -130,3 +130,32 @@ fn the_contacts_of_the_scene_set_the_limit() {
     let kinds: Vec<Pair> = quick.pairs().iter().map(|p| p.0).collect();
     assert_eq!(kinds, [Pair::FreeFree, Pair::FreeWall]);
 }
+
+/// A value of the wrong type or length inside a sphere of the tagged `[scene]` table is found
+/// at the key holding it, and a wrong element of a multi-line array at its key.
+#[test]
+fn a_bad_value_inside_a_tagged_table_or_an_array_is_found_at_its_key() {
+    let x = "x = [0.5005, 0.0, 0.0]";
+    let line = PAIR.lines().position(|l| l == x).unwrap() + 1;
+    for (to, msg) in [
+        ("x = [0.5005, 0.0, \"a\"]", "invalid type: string \"a\""),
+        ("x = [0.5005, 0.0]", "invalid length 2"),
+    ] {
+        let e = Case::parse(&PAIR.replace(x, to), "p.toml").unwrap_err();
+        assert_eq!(
+            (e.line, e.field.as_str()),
+            (line, "scene.sphere[1].x"),
+            "{e}"
+        );
+        assert!(e.msg.starts_with(msg), "{e}");
+    }
+    let periodic = "periodic = [false, false, false]";
+    let line = PAIR.lines().position(|l| l == periodic).unwrap() + 1;
+    let bad = PAIR.replace(periodic, "periodic = [false,\n  false,\n  0]");
+    let e = Case::parse(&bad, "p.toml").unwrap_err();
+    assert_eq!(
+        (e.line, e.field.as_str()),
+        (line + 2, "domain.periodic"),
+        "{e}"
+    );
+}
