@@ -35,7 +35,8 @@ fn developed(threads: usize) -> (Case, Box<dyn Engine>) {
             threads: Some(threads),
             ..Overrides::default()
         },
-    );
+    )
+    .unwrap();
     e.advance(1).unwrap();
     (case, e)
 }

@@ -450,9 +450,8 @@ mod tests {
         let eta = NORMAL.gamma / m;
         let tc = std::f64::consts::PI / (NORMAL.k / meff - eta * eta).sqrt();
         let e = (-eta * tc).exp();
-        // verdem's engine itself (`verdem run`, two spheres closing at 1, dt = tc/50,
-        // 2026-11-24): the relative restitution error is −3.434e-4 when they touch half a step
-        // in, +3.800e-3 when 0.03 of a step in and −2.321e-4 when 0.97 of a step in.
+        // the relative restitution errors `verdem run` gives two spheres closing at 1 at
+        // dt = tc/50, touching half a step, 0.97 and 0.03 of a step in (docs/stability.md)
         for (phase, engine) in [(0.5, -3.434e-4), (0.97, 3.800e-3), (0.03, -2.321e-4)] {
             let got = discrete_restitution(meff, NORMAL, tc / 50.0, phase).unwrap() / e - 1.0;
             assert!(
@@ -464,8 +463,8 @@ mod tests {
         // first order: halving dt about halves the worst error
         let ratio = err(50.0) / err(100.0);
         assert!(ratio > 1.5 && ratio < 2.6, "{ratio}");
-        // near the stability limit (tc/dt = 1.624) collisions gain energy: verdem extremes
-        // measured e = 1.02 at tc/dt = 2 averaged over onsets
+        // near the stability limit (tc/dt = 1.624) collisions gain energy on average
+        // (`verdem extremes`, docs/extremes.md)
         assert!(err(2.0) > 0.1, "{}", err(2.0));
         assert!(err(1.5) > err(2.0), "beyond the limit it is worse still");
     }

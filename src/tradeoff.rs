@@ -301,7 +301,7 @@ pub fn run(
             };
             let mut start = crate::scene::build(&v.case, Some(state))?;
             perturb(&mut start.particles, plan.perturbation, seed)?;
-            let mut e = engine::build(&v.case, start, &v.overrides);
+            let mut e = engine::build(&v.case, start, &v.overrides)?;
             let dir = out
                 .join(v.name.replace(['/', ' ', '=', '(', ')', ','], "_"))
                 .join(format!("replica_{k}"));

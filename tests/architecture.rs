@@ -7,12 +7,6 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Upward imports allowed for now, each (from, to) with its reason.
-const EXCEPTIONS: &[(&str, &str)] = &[
-    // `case` re-exports `contact::Tangential`; the split of case.rs removes it (delete at merge).
-    ("case", "contact"),
-];
-
 /// An import of a module from one on the same line or above it.
 #[derive(Debug, PartialEq)]
 struct Upward {
@@ -183,7 +177,7 @@ fn upward_imports(depth: &BTreeMap<String, usize>, files: &[(PathBuf, String)]) 
             .get(from)
             .unwrap_or_else(|| panic!("{}: module `{from}` is not in the layers", rel.display()));
         for (line, to) in named_modules(&code_of(text), &module) {
-            if &to == from || EXCEPTIONS.contains(&(from.as_str(), to.as_str())) {
+            if &to == from {
                 continue;
             }
             let theirs = depth.get(&to).unwrap_or_else(|| {

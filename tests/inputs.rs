@@ -1426,7 +1426,7 @@ fn small_case() -> Case {
 fn small_engine() -> Box<dyn Engine> {
     let case = small_case();
     let scene = verdem::scene::build(&case, Some(&corpus("small.data"))).unwrap();
-    engine::build(&case, scene, &Overrides::default())
+    engine::build(&case, scene, &Overrides::default()).unwrap()
 }
 
 proptest! {

@@ -55,7 +55,7 @@ fn assert_defects(peer: MotionPeer, rows: &[Row], ours: &[Row]) {
 /// The objectivity case (the two spheres and the benchmark's law) in `peer`'s convention.
 fn case_of(peer: MotionPeer) -> Case {
     let mut case = Case::load(&common::root().join("cases/verify/objectivity.toml")).unwrap();
-    case.contact.tangential = peer.convention();
+    case.contact.tangential = peer.convention().into();
     case
 }
 
@@ -73,7 +73,7 @@ fn loaded(peer: MotionPeer) -> bool {
 /// verdem's re-implementation of the case's convention through `rows`.
 fn verdem(case: &Case, rows: &[MotionRow]) -> Vec<ForceRow> {
     let (_, radius) = kinematics::pair_of(case).unwrap();
-    let law = kinematics::law_of(case);
+    let law = kinematics::law_of(case).unwrap();
     kinematics::drive(law.as_ref(), radius, rows, Increment::Positions)
 }
 
@@ -359,7 +359,7 @@ fn the_command_line_drives_the_peers_with_either_increment() {
             );
             assert_eq!(written.lines().count(), expected.lines().count());
             let (_, radius) = kinematics::pair_of(&case).unwrap();
-            let law = kinematics::law_of(&case);
+            let law = kinematics::law_of(&case).unwrap();
             let ours = kinematics::drive(law.as_ref(), radius, &rows, increment);
             let d = difference(&real, &ours);
             assert!(d <= bound(rows.len()), "{peer:?} {increment:?}: {d:e}");

@@ -398,7 +398,7 @@ fn cross_runs_agree_to_round_off_with_the_peers_convention_and_not_without() {
     let r = cross(
         peers::by_name("lammps").unwrap(),
         &case,
-        verdem::case::Tangential::Mercury,
+        verdem::contact::Tangential::Mercury,
         &state,
         2000,
         1000,

@@ -2,7 +2,7 @@
 
 mod common;
 
-use verdem::case::Tangential;
+use verdem::contact::Tangential;
 
 #[test]
 fn binary_collisions_match_the_closed_forms_at_the_benchmark_time_step() {
@@ -159,7 +159,7 @@ fn the_kinematics_command_writes_the_forces_of_the_driver() {
     // the command reads the motion back (quaternions normalised) and drives the same law
     let read = verdem::verify::kinematics::parse_motion("m", &motion_csv(&rows)).unwrap();
     let expected = forces_csv(&drive(
-        law_of(&case).as_ref(),
+        law_of(&case).unwrap().as_ref(),
         radius,
         &read,
         Increment::Positions,
@@ -269,7 +269,7 @@ fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coars
     let expected = |rows: &[verdem::verify::kinematics::MotionRow]| {
         let read = parse_motion("m", &motion_csv(rows)).unwrap();
         forces_csv(&drive(
-            law_of(&case).as_ref(),
+            law_of(&case).unwrap().as_ref(),
             radius,
             &read,
             Increment::Positions,

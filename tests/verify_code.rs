@@ -8,7 +8,8 @@ mod common;
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use verdem::case::{Case, Tangential};
+use verdem::case::Case;
+use verdem::contact::Tangential;
 use verdem::verify::driver::{External, MotionDriver, OWN};
 use verdem::verify::kinematics::{self, ForceRow, MotionRow};
 use verdem::verify::{self, Row, Subject};

@@ -4,7 +4,8 @@
 
 mod common;
 
-use verdem::case::{Case, Tangential};
+use verdem::case::Case;
+use verdem::contact::Tangential;
 use verdem::verify::driver::OWN;
 use verdem::verify::mcnamara::{
     cycle, cycle_rows, loads, scaling, theory_factor, Rotation, CYCLES,
@@ -14,7 +15,7 @@ use verdem::verify::{Row, Subject};
 fn pair(conv: Tangential) -> Case {
     let mut case =
         Case::load(&common::root().join("cases/verify/objectivity.toml")).expect("the case");
-    case.contact.tangential = conv;
+    case.contact.tangential = conv.into();
     case
 }
 

@@ -5,7 +5,8 @@
 
 mod common;
 
-use verdem::case::{Case, Tangential};
+use verdem::case::Case;
+use verdem::contact::Tangential;
 use verdem::peers::{self, Peer, Run, Save};
 
 fn yade() -> &'static dyn Peer {
@@ -33,7 +34,7 @@ fn yade_collisions_give_the_clipped_closed_forms_and_verdems_restitution() {
     assert!(rows.iter().any(|r| r.quantity.starts_with("contact time")));
     let mut clipped = case.clone();
     clipped.contact.clip_normal = true;
-    clipped.contact.tangential = Tangential::YadeViscEl;
+    clipped.contact.tangential = Tangential::YadeViscEl.into();
     let m = case.particle_mass();
     for (v0, wall, meff) in [(1.0, false, 0.5 * m), (0.1, true, m)] {
         let own = verdem::verify::collide(&clipped, v0, wall, 50.0).unwrap().e;

@@ -155,7 +155,7 @@ pub fn write_peer_state(
         case,
         crate::scene::build(case, Some(state))?,
         &Overrides::default(),
-    );
+    )?;
     let file = peer.write_state(&e.snapshot(), case.material.density, work, stem)?;
     let path = work.join(file);
     path.canonicalize()
@@ -205,7 +205,7 @@ pub(super) fn round(
                                 threads: Some(*threads),
                                 ..Overrides::default()
                             },
-                        );
+                        )?;
                         e.advance(0)?;
                         *e.counters_mut() = StageTimes::default();
                         e.params_mut().meet = barrier

@@ -8,6 +8,7 @@ use verdem::analysis::cg::{self, Series};
 use verdem::analysis::report::Report;
 use verdem::analysis::Verdict;
 use verdem::case::Case;
+use verdem::contact::named;
 use verdem::io::lock::{self, FolderLock};
 use verdem::scene;
 use verdem::step::engine::{self, Overrides};
@@ -83,7 +84,7 @@ impl Common {
     /// The case and its engine, built with the command line's overrides; warns when the team
     /// has more threads than the process may use CPUs.
     pub fn load(&self) -> anyhow::Result<(Case, Box<dyn Engine>)> {
-        let mut case = Case::load(&self.case)?;
+        let mut case = named::load(&self.case)?;
         if let Some(overlap) = self.guard_overlap {
             case.guard.overlap = overlap;
         }
@@ -100,7 +101,7 @@ impl Common {
             skin: self.skin,
             cell: self.cell,
         };
-        let engine = engine::build(&case, scene, &o);
+        let engine = engine::build(&case, scene, &o)?;
         if let Some(warning) = verdem::team::oversubscribed(engine.params().threads) {
             eprintln!("warning: {warning}");
         }

@@ -8,6 +8,7 @@ use anyhow::{bail, Context};
 use verdem::bench::{self, AtSize, Config, Size};
 use verdem::case::Case;
 use verdem::child::{self, OnParentDeath};
+use verdem::contact::named;
 use verdem::io::atomic;
 use verdem::scene;
 
@@ -95,7 +96,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         .case
         .clone()
         .unwrap_or_else(|| PathBuf::from("cases/shear_flow_quick.toml"));
-    let case = Case::load(&case_path)?;
+    let case = named::load(&case_path)?;
     if let Some(probe) = &a.probe {
         let from = a.from.clone().unwrap_or_else(|| DEVELOPING.into());
         return run_probe(&case, &from, a.steps, probe, &a.out);
@@ -159,7 +160,7 @@ fn sweep(a: &Args, case_path: &Path, configs: &[Config]) -> anyhow::Result<Finis
     for &n in &a.scale {
         let work = a.out.join(format!("{n}x{n}"));
         let (case_file, state) = verdem::scene::tile::write(case_path, &from, n, n, &work)?;
-        let case = Case::load(&case_file)?;
+        let case = named::load(&case_file)?;
         let particles = scene::build(&case, Some(&state))?.particles.len();
         sizes.push(Size {
             case,

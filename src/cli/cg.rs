@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use verdem::analysis::cg::{self, CgOptions, KernelChoice};
-use verdem::case::Case;
+use verdem::contact::named;
 use verdem::state::memory;
 
 use super::args::{complete_series, count, named, positive};
@@ -52,7 +52,7 @@ pub struct Args {
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let saves = match a.case {
-        Some(c) => CgOptions::for_case(&Case::load(&c)?),
+        Some(c) => CgOptions::for_case(&named::load(&c)?),
         None => CgOptions::default(),
     };
     let o = CgOptions {

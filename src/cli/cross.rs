@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use verdem::analysis::difference::Difference;
 use verdem::analysis::report::{Case as ReportCase, Detail, Report};
 use verdem::analysis::{Limit, Outcome, Verdict};
-use verdem::case::{Case, Tangential};
+use verdem::contact::named;
+use verdem::contact::Tangential;
 use verdem::peers::{cross, Peer};
 use verdem::run;
 
@@ -188,7 +189,7 @@ fn core_mean_case(suite: &str, a: &str, b: &str, d: &Difference, judged: bool) -
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(&a.case)?;
+    let case = named::load(&a.case)?;
     let out = a.out.join(a.peer.binary());
     let lock = lock_output_folder(&out)?;
     for series in [a.peer.binary(), "verdem"] {

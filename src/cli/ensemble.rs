@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 
-use verdem::case::Case;
+use verdem::contact::named;
 use verdem::ensemble::{self, local, slurm, Plan, ReplicaCommand};
 
 use super::args::{count, lock_output_folder, named, non_negative, positive};
@@ -91,7 +91,7 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(&a.case)?;
+    let case = named::load(&a.case)?;
     let out = a
         .out
         .clone()

@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use verdem::case::{Case, COARSE_STEPS_PER_COLLISION};
+use verdem::case::COARSE_STEPS_PER_COLLISION;
+use verdem::contact::named;
 use verdem::io::{self, atomic};
 use verdem::peers::motion::{self, MotionPeer};
 use verdem::verify::kinematics::{self, Increment};
@@ -41,7 +42,7 @@ pub struct Args {
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     // no integration: the law's checks, not the scheme's stability limit on run.dt
-    let case = Case::load_for_prescribed_motion(&a.case)?;
+    let case = named::load_for_prescribed_motion(&a.case)?;
     let (file, text) = io::read_text(&a.motion)?;
     let (lines, rows): (Vec<usize>, Vec<_>) = kinematics::parse_motion_lines(&file, &text)?
         .into_iter()
@@ -64,7 +65,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     }
     let forces = match a.peer {
         None => {
-            let law = kinematics::law_of(&case);
+            let law = kinematics::law_of(&case)?;
             kinematics::drive(law.as_ref(), radius, &rows, a.increment)
         }
         Some(peer) => motion::drive(peer, &case, &rows, a.increment)?,

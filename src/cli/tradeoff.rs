@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use verdem::case::Case;
+use verdem::contact::named;
 use verdem::io::atomic;
 use verdem::run;
 use verdem::tradeoff::{self, Plan};
@@ -56,7 +56,7 @@ pub struct Args {
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
-    let case = Case::load(&a.case)?;
+    let case = named::load(&a.case)?;
     if let Some(path) = &a.table {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("{}: cannot read", path.display()))?;
@@ -67,7 +67,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         );
         return Ok(Finished::Done);
     }
-    let pair = Case::load(&a.pair)?;
+    let pair = named::load(&a.pair)?;
     let lock = lock_output_folder(&a.out)?;
     for variant in std::fs::read_dir(&a.out).into_iter().flatten().flatten() {
         if !variant.path().is_dir() {

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use verdem::case::{Case, Tangential};
+use verdem::contact::named;
+use verdem::contact::Tangential;
 use verdem::peers::motion::MotionPeer;
 use verdem::peers::{self, Peer};
 use verdem::verify::driver::External;
@@ -94,7 +95,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         }
         None => verify::run(&verify::select(verify::entries(&a.cases), only)?)?,
     };
-    let collision = Case::load(&a.cases.join("binary_collision.toml"))?;
+    let collision = named::load(&a.cases.join("binary_collision.toml"))?;
     let mut chosen = Vec::new();
     for &peer in &a.peers {
         let dir = a.out.join(peer.binary());

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::bail;
 
 use verdem::analysis::cg::CgOptions;
-use verdem::case::Case;
+use verdem::contact::named;
 use verdem::io::{mercury, vtk};
 
 use super::args::complete_series;
@@ -28,7 +28,7 @@ pub struct Args {
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
     let walls = match &a.case {
-        Some(c) => CgOptions::for_case(&Case::load(c)?).walls,
+        Some(c) => CgOptions::for_case(&named::load(c)?).walls,
         None => CgOptions::default().walls,
     };
     let series = complete_series(&a.base, a.skip_incomplete)?;

@@ -9,6 +9,7 @@
 //! is positive in contact; the contact point is `c = x_P − (r_P − δ/2) n`; forces are those on
 //! P (I receives the opposite).
 
+pub mod named;
 pub mod normal;
 pub mod registry;
 pub mod tangential;

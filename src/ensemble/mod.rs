@@ -297,7 +297,7 @@ impl Plan {
                 threads: Some(1),
                 ..Overrides::default()
             },
-        );
+        )?;
         let start_hash = hash::state_hash(&engine.snapshot());
         let dir = replica_dir(&self.out, k);
         let lock = lock::lock_folder(&dir)?;

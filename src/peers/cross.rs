@@ -30,7 +30,8 @@ use crate::analysis::difference::{differences, Difference};
 use crate::analysis::inrun::{self, InrunResult, Sampling};
 use crate::analysis::stats::quantile;
 use crate::analysis::{Limit, Verdict};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::io::atomic;
 use crate::io::mercury::{data_text, fstat_text};
 use crate::step::engine::{self, Overrides};
@@ -263,13 +264,13 @@ pub fn cross_inrun(
         .transpose()?;
     let own_case = case;
     let mut case = case.clone();
-    case.contact.tangential = convention;
+    case.contact.tangential = convention.into();
     case.contact.clip_normal = peer.clips_normal_force();
     let overrides = Overrides {
         threads: Some(np),
         ..Overrides::default()
     };
-    let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides);
+    let mut e = engine::build(&case, crate::scene::build(&case, Some(state))?, &overrides)?;
     e.params_mut().setup_advances_history = peer.setup_advances_history();
     e.advance(0)?;
     let template = e.snapshot();
@@ -348,7 +349,7 @@ pub fn cross_inrun(
             peer: peer_profiles(peer, &run, &o, &template, s, case.dt())?,
             verdem_as_peer: acc.result().context("verdem: no in-run sample")?,
             verdem: own_profiles(own_case, state, np, s)?,
-            own_convention: own_case.contact.tangential,
+            own_convention: Tangential::of(&own_case.contact)?,
         }),
         _ => None,
     };
@@ -387,7 +388,7 @@ pub fn cross_inrun(
     let report = Report {
         peer,
         np,
-        convention: case.contact.tangential,
+        convention: Tangential::of(&case.contact)?,
         saves,
         profiles_chi2,
         inrun,
@@ -425,7 +426,7 @@ fn own_profiles(case: &Case, state: &Path, np: usize, s: Sampling) -> anyhow::Re
         threads: Some(np),
         ..Overrides::default()
     };
-    let mut e = engine::build(case, crate::scene::build(case, Some(state))?, &overrides);
+    let mut e = engine::build(case, crate::scene::build(case, Some(state))?, &overrides)?;
     e.advance(0)?;
     let mut acc = inrun::Inrun::new(&cg::CgOptions::for_case(case), &e.state().domain, s)?
         .with_reference_tau(case.dt());

@@ -21,8 +21,9 @@ use anyhow::{bail, ensure, Context};
 
 use super::lammps_family::dump;
 use super::{Frame, Installed, Lacks, Launch, Peer, Run, Save};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::io::atomic;
 use crate::python::{python, Python, Source, VENV};
 use crate::state::{Contact, Motion, Snapshot};

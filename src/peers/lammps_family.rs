@@ -24,8 +24,9 @@ use super::{
     placed_contacts, wall_speeds, Frame, Installed, Lacks, Launch, Naming, Peer, Program, Run,
     Save, MPIRUN,
 };
-use crate::case::{Case, Tangential};
+use crate::case::Case;
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::io::atomic;
 use crate::state::Motion;
 use crate::state::{Contact, Snapshot};

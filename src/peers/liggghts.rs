@@ -3,7 +3,8 @@
 
 use super::lammps_family::{boundary, neighbor, Dialect, DUMP_COLUMNS, GROUPS};
 use super::motion::MotionPeer;
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::state::Snapshot;
 use crate::Vec3;
 

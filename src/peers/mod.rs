@@ -25,8 +25,9 @@ pub mod motion;
 pub mod yade;
 
 use self::motion::MotionPeer;
-use crate::case::{Case, Scene, Tangential};
+use crate::case::{Case, Scene};
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::io::mercury;
 use crate::state::{Contact, PairForce, Snapshot};
 use crate::Vec3;

@@ -31,8 +31,9 @@ use anyhow::{bail, ensure, Context};
 use super::{
     placed_contacts, wall_speeds, Frame, Installed, Lacks, Launch, Naming, Peer, Program, Run, Save,
 };
-use crate::case::{Case, Tangential};
+use crate::case::Case;
 use crate::child::{self, OnParentDeath};
+use crate::contact::Tangential;
 use crate::io::{atomic, parse_numbers, read_text, FormatError};
 use crate::state::{Contact, Motion, Snapshot};
 use crate::Vec3;

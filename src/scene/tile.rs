@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 
 use crate::case::{Case, Scene as SceneSpec};
+use crate::contact::named;
 use crate::io::{atomic, mercury};
 use crate::state::{Domain, Motion, Particles, Snapshot};
 use crate::Vec3;
@@ -168,7 +169,7 @@ pub fn write(
     ny: usize,
     out: &Path,
 ) -> anyhow::Result<(PathBuf, PathBuf)> {
-    let case = Case::load(case_path)?;
+    let case = named::load(case_path)?;
     let (_, text) = crate::io::read_text(case_path)?;
     let name = tiled_name(&case.name, nx, ny);
     let data = format!("{name}.data");

@@ -5,11 +5,11 @@
 
 use super::guard::Failure;
 use super::{energy, Core, Flows, Params, Reading, Simulation, StageTimes, State};
-use crate::case::{self, Case};
+use crate::case::{self, Case, CaseError};
 use crate::contact::normal::Clipped;
 use crate::contact::{
-    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, TangentialModel,
-    TangentialVisitor,
+    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, Tangential,
+    TangentialModel, TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
 use crate::state::{Domain, History, Particles, SampledContact, Snapshot};
@@ -169,21 +169,23 @@ pub trait LawVisitor {
     fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Self::Output;
 }
 
-/// Composes the contact law of `c` and hands it to `v`. Without friction the law has no
-/// tangential history, torque or spin (model only what the case needs).
-pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> V::Output {
+/// Composes the contact law of `c` and hands it to `v`; an error when `c` names no
+/// tangential convention ([`Tangential::of`]), with or without friction. Without friction the
+/// law has no tangential history, torque or spin (model only what the case needs).
+pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> Result<V::Output, CaseError> {
+    let tangential = Tangential::of(c)?;
     let normal = LinearSpringDashpot {
         kn: c.kn,
         gamman: c.gamman,
     };
-    if c.clip_normal {
-        with_tangential(c, Clipped(normal), v)
+    Ok(if c.clip_normal {
+        with_tangential(c, tangential, Clipped(normal), v)
     } else {
-        with_tangential(c, normal, v)
-    }
+        with_tangential(c, tangential, normal, v)
+    })
 }
 
-fn with_tangential<N, V>(c: &case::Contact, normal: N, v: V) -> V::Output
+fn with_tangential<N, V>(c: &case::Contact, tangential: Tangential, normal: N, v: V) -> V::Output
 where
     N: NormalModel + Clone + 'static,
     V: LawVisitor,
@@ -194,8 +196,7 @@ where
             tangential: Frictionless,
         });
     }
-    c.tangential
-        .with_model(c.kt, c.gammat, c.mu, ComposeWith { normal, v })
+    tangential.with_model(c.kt, c.gammat, c.mu, ComposeWith { normal, v })
 }
 
 /// Composes a normal model with the tangential model the registry builds, for a visitor.
@@ -248,8 +249,9 @@ impl LawVisitor for BuildSimulation {
     }
 }
 
-/// A ready-to-run simulation of `scene` under the case's contact law.
-pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Box<dyn Engine> {
+/// A ready-to-run simulation of `scene` under the case's contact law; an error when the case
+/// names no tangential convention.
+pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Result<Box<dyn Engine>, CaseError> {
     let r_max = scene.particles.radius.iter().cloned().fold(0.0, f64::max);
     let builder = NeighborBuilder::new(
         o.skin.unwrap_or(case.neighbor.skin),

@@ -751,7 +751,7 @@ mod tests {
                 search: case.neighbor.search,
                 steps,
             };
-            engine::with_law(&case.contact, run);
+            engine::with_law(&case.contact, run).unwrap();
         }
     }
 }

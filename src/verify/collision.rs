@@ -123,7 +123,7 @@ pub fn impact_setup(
         s.fixed = b.fixed;
     }
     let scene = crate::scene::build(&case, None)?;
-    let e = engine::build(&case, scene, &Overrides::default());
+    let e = engine::build(&case, scene, &Overrides::default())?;
     Ok((case, e))
 }
 

@@ -18,7 +18,8 @@
 //!   symmetry; hence the open cluster.)
 
 use super::{row_abs, Row};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::scene::{self, random_velocities, Scene};
 use crate::state::Domain;
 use crate::state::Snapshot;
@@ -58,7 +59,7 @@ pub struct GasRun {
 /// Runs the gas of `case` for `steps` steps, sampling the totals every `steps/100`.
 pub fn gas(case: &Case, steps: u64) -> anyhow::Result<GasRun> {
     let sc = scene::build(case, None)?;
-    let mut e = engine::build(case, sc, &Overrides::default());
+    let mut e = engine::build(case, sc, &Overrides::default())?;
     e.advance(0)?;
     let first = e.snapshot();
     let (e0, p0, _) = totals(&first, case.contact.kn);
@@ -115,7 +116,7 @@ pub fn cluster(case: &Case) -> Scene {
 
 /// Relative change of the cluster's angular momentum over `steps` steps of `case`'s law.
 pub fn cluster_angular_momentum(case: &Case, steps: u64) -> anyhow::Result<f64> {
-    let mut e = engine::build(case, cluster(case), &Overrides::default());
+    let mut e = engine::build(case, cluster(case), &Overrides::default())?;
     e.advance(0)?;
     let first = e.snapshot();
     let (_, _, l0) = totals(&first, case.contact.kn);
@@ -168,7 +169,7 @@ pub fn rows(base: &Case, steps: u64) -> anyhow::Result<Vec<Row>> {
     ));
     for conv in Tangential::ALL {
         let mut case = base.clone();
-        case.contact.tangential = conv;
+        case.contact.tangential = conv.into();
         let dl = cluster_angular_momentum(&case, 2000)?;
         // lever arms to a common contact point: round-off only (measured 1.7e-13 over 2000
         // steps); full-radius lever arms lose δ n × Ft per contact, 3.8e-5 here

@@ -41,7 +41,7 @@ pub const OWN: Own = Own {
 impl MotionDriver for Own {
     fn drive(&self, case: &Case, motion: &[MotionRow]) -> anyhow::Result<Vec<ForceRow>> {
         let (_, radius) = kinematics::pair_of(case)?;
-        let law = kinematics::law_of(case);
+        let law = kinematics::law_of(case)?;
         Ok(kinematics::drive(
             law.as_ref(),
             radius,

@@ -129,8 +129,8 @@ impl LawVisitor for Boxed {
     }
 }
 
-/// The contact law of `case`.
-pub fn law_of(case: &Case) -> Box<dyn DynLaw> {
+/// The contact law of `case`; an error when the case names no tangential convention.
+pub fn law_of(case: &Case) -> Result<Box<dyn DynLaw>, crate::case::CaseError> {
     engine::with_law(&case.contact, Boxed)
 }
 
@@ -529,7 +529,7 @@ mod tests {
             ..still(1e-4, 1e-3)
         });
         let f = drive(
-            law_of(&case).as_ref(),
+            law_of(&case).unwrap().as_ref(),
             [0.5, 0.5],
             &rows,
             Increment::Trapezoid,
@@ -587,7 +587,7 @@ mod tests {
             "b.toml",
         )
         .unwrap();
-        let law = law_of(&case);
+        let law = law_of(&case).unwrap();
         let rows = [still(0.0, 1e-3), still(1e-4, 1e-3), still(2e-4, -1e-3)];
         let f = drive(law.as_ref(), [0.5, 0.5], &rows, Increment::Positions);
         // n from 1 to 2 is +z: sphere 2 is pushed along +z, sphere 1 along −z

@@ -27,7 +27,8 @@ use super::driver::{MotionDriver, OWN};
 use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
 use super::ratchet::net_work;
 use super::{row_abs, Row, Subject};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::kinematics::{pair_of, MotionRow};
 use crate::Vec3;
 

@@ -30,8 +30,9 @@ use std::path::Path;
 
 use crate::analysis::verdict::Outcome;
 use crate::analysis::{Limit, Verdict};
-use crate::case::{Case, Tangential, COARSE_STEPS_PER_COLLISION};
+use crate::case::{Case, COARSE_STEPS_PER_COLLISION};
 use crate::contact::registry::Properties;
+use crate::contact::Tangential;
 pub use collision::{binary_collisions, closed_form, collide, ClosedForm, Measured};
 use driver::{MotionDriver, OWN};
 
@@ -134,7 +135,7 @@ impl<'a> Subject<'a> {
     /// `base` with this subject's tangential convention.
     pub fn case(&self, base: &Case) -> Case {
         let mut case = base.clone();
-        case.contact.tangential = self.tangential;
+        case.contact.tangential = self.tangential.into();
         case
     }
 }

@@ -14,7 +14,8 @@ use nalgebra::{Rotation3, Unit, UnitQuaternion};
 
 use super::driver::MotionDriver;
 use super::{row_abs, Row, Subject};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 

@@ -17,7 +17,8 @@
 //! tangential force may arise, and the final tangential velocities are zero.
 
 use super::{closed_form, row, row_abs, Row};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::collision::{impact, Body, Outcome};
 use crate::Vec3;
 
@@ -54,18 +55,20 @@ fn on_wall(case: &Case, vn: f64, vt: f64, spin_slip: f64) -> anyhow::Result<(f64
 }
 
 /// Relative tolerance of Jt/Jn = μ: the contact sticks in its first and last steps, where the
-/// spring has not reached the cap, an O(dt) shortfall of measured ≤ 1.9e-5 at tc/50; 5 times
-/// that, below the 1e-3 of a law whose μ is 0.1 % off.
+/// spring has not reached the cap, an O(dt) shortfall (measured at tc/50 in
+/// `docs/verification.md`, "Tolerances"); 5 times that, below the 1e-3 of a law whose μ is
+/// 0.1 % off.
 const MU_TOLERANCE: f64 = 1e-4;
 
 /// Absolute tolerance of β = e while sticking: the scheme's first-order error in e (8e-4 at
 /// tc/50, free–wall) plus the effect of the lever arm R − δ/2 and of the wall sphere's
-/// curvature on the tangential oscillator, O(δmax/R) = 3e-3; measured ≤ 1.8e-3.
+/// curvature on the tangential oscillator, O(δmax/R) = 3e-3 (the error measured is in
+/// `docs/verification.md`, "Tolerances").
 const STICK_TOLERANCE: f64 = 4e-3;
 
 /// Absolute tolerance of β = 7μ(1 + e)/(2ψ) − 1 while sliding: the first-order error of the
-/// clipped e (1.8e-4 relative at tc/50) and the sticking first and last steps; measured
-/// ≤ 4.5e-4.
+/// clipped e (1.8e-4 relative at tc/50) and the sticking first and last steps (the error
+/// measured is in `docs/verification.md`, "Tolerances").
 const SLIDE_TOLERANCE: f64 = 2e-3;
 
 /// The oblique-impact rows of every tangential convention for the case `base` (whose law must
@@ -91,7 +94,7 @@ pub fn rows_against(reference: &Case, simulated: &Case) -> anyhow::Result<Vec<Ro
     let mut rows = Vec::new();
     for conv in Tangential::ALL {
         let mut unclipped = simulated.clone();
-        unclipped.contact.tangential = conv;
+        unclipped.contact.tangential = conv.into();
         unclipped.contact.clip_normal = false;
         let mut clipped = unclipped.clone();
         clipped.contact.clip_normal = true;
@@ -176,7 +179,7 @@ fn opposite_spins(case: &Case) -> anyhow::Result<Vec<Row>> {
         .norm()
         .max((out.w[1] - Vec3::new(0.0, 0.0, -10.0)).norm());
     let name = format!("opposite spins {}", case.contact.tangential.name());
-    // mirror images: every tangential force and torque cancels exactly (measured 0)
+    // mirror images: every tangential force and torque cancels exactly
     Ok(vec![
         row_abs(&name, "final tangential speed = 0", 0.0, tangential, 1e-12),
         row_abs(&name, "spin change = 0", 0.0, spin_change, 1e-10),

@@ -19,7 +19,8 @@ use nalgebra::{Unit, UnitQuaternion};
 use super::driver::MotionDriver;
 use super::objectivity::{rigid_rotation, tangent_axis};
 use super::{row_abs, Row, Subject};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 

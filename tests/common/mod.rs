@@ -45,7 +45,7 @@ pub fn quick_case() -> Case {
 /// An engine for `case` starting from `init` (or the generated scene), with overrides.
 pub fn engine(case: &Case, init: Option<&Path>, o: Overrides) -> Box<dyn Engine> {
     let s = scene::build(case, init).expect("scene builds");
-    engine::build(case, s, &o)
+    engine::build(case, s, &o).expect("the case names a convention")
 }
 
 /// State hash after `steps` steps.

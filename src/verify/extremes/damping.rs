@@ -71,7 +71,7 @@ fn elastic(base: &Case) -> anyhow::Result<Result<(f64, f64), crate::step::guard:
         periodic: [true, false, false],
     };
     let scene = crate::scene::build(&case, None)?;
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     let kn = case.contact.kn;
     let e0 = energy(e.as_ref(), kn);
     let (mut deviation, mut level) = (0.0f64, 0.0f64);
@@ -111,7 +111,7 @@ pub fn clipped_overdamped_restitution(zeta: f64) -> f64 {
 /// force, and whether the spheres still touch.
 fn damped(case: &Case, steps: u64) -> anyhow::Result<(f64, f64, bool)> {
     let scene = crate::scene::build(case, None)?;
-    let mut e = super::engine_of(case, scene);
+    let mut e = super::engine_of(case, scene)?;
     let mut fn_min = f64::INFINITY;
     for _ in 0..steps {
         e.advance(1)?;
@@ -288,7 +288,7 @@ fn pressed(case: &Case) -> anyhow::Result<Result<bool, crate::step::guard::Failu
         ],
     );
     let scene = crate::scene::build(&case, None)?;
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     if let Err(f) = e.advance(2000) {
         return Ok(Err(f));
     }

@@ -131,7 +131,7 @@ fn mu_changed(
         .collect();
     sticking.scene = SceneSpec::Spheres { sphere: spheres };
     let scene = crate::scene::build(&sticking, None)?;
-    let mut e = super::engine_of(&sticking, scene);
+    let mut e = super::engine_of(&sticking, scene)?;
     let half = (closed_form(&sticking, sticking.particle_mass()).tc / (2.0 * sticking.dt())) as u64;
     let mut in_contact = 0;
     while in_contact < half {
@@ -154,7 +154,7 @@ fn mu_changed(
             let mut case = accepted.case.clone();
             case.scene = sticking.scene.clone();
             let scene = crate::scene::build(&case, None)?;
-            let mut resumed = super::engine_of(&case, scene);
+            let mut resumed = super::engine_of(&case, scene)?;
             match checkpoint::read(&ck, resumed.as_mut(), &tag) {
                 Err(err) => (f64::NAN, Did::Refused(format!("{err:#}"))),
                 Ok(_) => {

@@ -291,8 +291,12 @@ pub fn stopped(f: &Failure) -> Did {
     Did::Stopped(format!("step {}: {}", f.step, f.what))
 }
 
-/// An engine of `scene` under `case` on one thread.
-pub fn engine_of(case: &Case, scene: crate::scene::Scene) -> Box<dyn Engine> {
+/// An engine of `scene` under `case` on one thread; an error when the case names no
+/// tangential convention.
+pub fn engine_of(
+    case: &Case,
+    scene: crate::scene::Scene,
+) -> Result<Box<dyn Engine>, crate::case::CaseError> {
     let o = Overrides {
         threads: Some(1),
         bind: Some(false),

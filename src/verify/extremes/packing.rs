@@ -44,7 +44,7 @@ pub fn gas(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
     let t = set(&t, "neighbor", "search", "\"all-pairs\"");
     let t = set(&t, "scene", "count", &GAS_COUNT.to_string());
     let scene = crate::scene::build(&case, None)?;
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     let totals = |e: &dyn crate::step::Engine| {
         let p = &e.state().particles;
         let (mut mom, mut mass, mut ke, mut vmax) = (Vec3::zeros(), 0.0, 0.0, 0.0f64);
@@ -212,7 +212,7 @@ pub fn jammed(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         particles,
         time: 0.0,
     };
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     let outcome = e.advance(0);
     let s = e.snapshot();
     let contacts = s.contacts.len();
@@ -374,7 +374,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         time: 0.0,
     };
     // the relaxed state as an initial file, which the case text names as a user's would
-    let relaxed = super::engine_of(&base, scene).snapshot();
+    let relaxed = super::engine_of(&base, scene)?.snapshot();
     std::fs::create_dir_all(&inputs.out)?;
     let init = inputs.out.join("dense_shear.data");
     crate::io::atomic::write(&init, crate::io::mercury::data_text(&relaxed).as_bytes())?;
@@ -400,7 +400,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
             top_vx,
         };
     }
-    let mut e = super::engine_of(&case, crate::scene::build(&case, None)?);
+    let mut e = super::engine_of(&case, crate::scene::build(&case, None)?)?;
     let mut largest = 0.0f64;
     let mut outcome = e.advance(0);
     for _ in 0..20 {

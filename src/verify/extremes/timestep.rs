@@ -248,7 +248,7 @@ pub fn sustained_stable(base: &Case, wall: bool, per_tc: f64) -> anyhow::Result<
     };
     case.scene = SceneSpec::Spheres { sphere: spheres };
     let scene = crate::scene::build(&case, None)?;
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     let mut largest = 0.0f64;
     for step in 0..2000 {
         if e.advance(1).is_err() {
@@ -306,7 +306,7 @@ pub fn shear_run(base: &Case, state: &Path, per_tc: f64) -> anyhow::Result<Resul
     case.run.dt = None;
     case.run.steps_per_collision = Some(per_tc);
     let scene = crate::scene::build(&case, Some(state))?;
-    let mut e = super::engine_of(&case, scene);
+    let mut e = super::engine_of(&case, scene)?;
     let kinetic = |e: &dyn crate::step::Engine| {
         let p = &e.state().particles;
         (0..p.len())

@@ -1,0 +1,109 @@
+//! `[contact]`: the contact law's parameters, and the name of its tangential convention.
+
+use serde::Deserialize;
+
+use super::locate::Locator;
+use super::CaseError;
+
+/// `[contact]`: the contact law.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Contact {
+    /// Normal spring stiffness (force/length).
+    pub kn: f64,
+    /// Absolute normal damping (mass/time).
+    pub gamman: f64,
+    /// Tangential spring stiffness (force/length).
+    #[serde(default)]
+    pub kt: f64,
+    /// Absolute tangential damping (mass/time).
+    #[serde(default)]
+    pub gammat: f64,
+    /// Coulomb friction coefficient; 0 switches friction (and rotation) off.
+    #[serde(default)]
+    pub mu: f64,
+    /// Tangential convention (default `mercury`), as named; the contact layer resolves it
+    /// (`contact::named`).
+    #[serde(default = "default_tangential")]
+    pub tangential: Convention,
+    /// Clip the attractive tail of the normal force, fn = max(fn, 0) (default false).
+    #[serde(default)]
+    pub clip_normal: bool,
+}
+
+fn default_tangential() -> Convention {
+    Convention {
+        name: "mercury".into(),
+        file: String::new(),
+        line: 0,
+    }
+}
+
+/// The name of a tangential convention as a case gives it, with where it was read (the file
+/// and the 1-based line of `[contact] tangential`, 0 when not read from a file), so that the
+/// contact layer, which knows the conventions, can refuse an unknown name at its line. Two
+/// are equal when they name the same convention.
+#[derive(Clone, Debug, Eq)]
+pub struct Convention {
+    /// The name (`mercury`, `objective`, …), not checked against the registry here.
+    pub name: String,
+    /// The file the name was read from, as errors name it.
+    pub file: String,
+    /// Its line (1-based; 0 unknown).
+    pub line: usize,
+}
+
+impl Convention {
+    /// The name as written in the case.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+impl PartialEq for Convention {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+/// Read as an enum's unit variant, as the registry's enum was: the parser's own messages for
+/// a value that is not a name (`wanted string or table`) stay the same; whether the name is a
+/// convention is the contact layer's check.
+impl<'de> Deserialize<'de> for Convention {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Name;
+        impl<'de> serde::de::Visitor<'de> for Name {
+            type Value = String;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("the name of a tangential convention")
+            }
+            fn visit_enum<A: serde::de::EnumAccess<'de>>(self, a: A) -> Result<String, A::Error> {
+                use serde::de::VariantAccess;
+                let (name, variant) = a.variant::<String>()?;
+                variant.unit_variant()?;
+                Ok(name)
+            }
+        }
+        let name = d.deserialize_enum("Tangential", &[], Name)?;
+        Ok(Convention {
+            name,
+            file: String::new(),
+            line: 0,
+        })
+    }
+}
+
+impl Contact {
+    /// kn > 0; gamman, kt, gammat, mu >= 0; kt > 0 with friction.
+    pub(super) fn check(&self, at: &Locator<'_>) -> Result<(), CaseError> {
+        at.positive("contact.kn", self.kn)?;
+        at.non_negative("contact.gamman", self.gamman)?;
+        at.non_negative("contact.kt", self.kt)?;
+        at.non_negative("contact.gammat", self.gammat)?;
+        at.non_negative("contact.mu", self.mu)?;
+        if self.mu > 0.0 {
+            at.positive("contact.kt", self.kt)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,93 @@
+//! The tangential convention a case names, resolved against the registry: the case file
+//! holds a name ([`case::Convention`]), the contact layer knows which names are conventions.
+
+use std::path::Path;
+use std::sync::LazyLock;
+
+use serde::de::Error as _;
+
+use super::Tangential;
+use crate::case::{self, Case, CaseError};
+
+/// The registry's names, in its order, as serde's messages list a field's choices.
+static NAMES: LazyLock<Vec<&'static str>> =
+    LazyLock::new(|| Tangential::ALL.iter().map(|t| t.name()).collect());
+
+impl Tangential {
+    /// The convention `contact.tangential` names, or the error `file:line:
+    /// contact.tangential: unknown variant …` at the line that names it.
+    pub fn of(contact: &case::Contact) -> Result<Tangential, CaseError> {
+        let named = &contact.tangential;
+        Tangential::named(named.name()).ok_or_else(|| CaseError {
+            file: named.file.clone(),
+            line: named.line,
+            field: "contact.tangential".into(),
+            msg: serde::de::value::Error::unknown_variant(named.name(), &NAMES).to_string(),
+        })
+    }
+}
+
+/// Reads a case file ([`Case::load`]) and refuses a tangential convention the registry does
+/// not know, as for a command that uses the case before (or without) building its law.
+pub fn load(path: &Path) -> Result<Case, CaseError> {
+    let case = Case::load(path)?;
+    Tangential::of(&case.contact)?;
+    Ok(case)
+}
+
+/// [`Case::load_for_prescribed_motion`], refusing an unknown tangential convention as [`load`].
+pub fn load_for_prescribed_motion(path: &Path) -> Result<Case, CaseError> {
+    let case = Case::load_for_prescribed_motion(path)?;
+    Tangential::of(&case.contact)?;
+    Ok(case)
+}
+
+/// The name of `t`, for a case whose convention is set in code (read from no file).
+impl From<Tangential> for case::Convention {
+    fn from(t: Tangential) -> case::Convention {
+        case::Convention {
+            name: t.name().into(),
+            file: String::new(),
+            line: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every registered name resolves to its convention, through a case as through code; an
+    /// unknown one is the error at the line that names it, listing the names.
+    #[test]
+    fn a_case_names_a_convention_or_gets_the_list() {
+        let text = include_str!("../../cases/shear_flow_quick.toml");
+        for t in Tangential::ALL {
+            let named = text.replace(
+                "tangential = \"mercury\"",
+                &format!("tangential = \"{}\"", t.name()),
+            );
+            let case = case::Case::parse(&named, "q.toml").unwrap();
+            assert_eq!(Tangential::of(&case.contact).unwrap(), t);
+            let mut set = case.clone();
+            set.contact.tangential = t.into();
+            assert_eq!(Tangential::of(&set.contact).unwrap(), t);
+        }
+        let bad = text.replace("tangential = \"mercury\"", "tangential = \"nope\"");
+        let case = case::Case::parse(&bad, "q.toml").unwrap();
+        let line = bad
+            .lines()
+            .position(|l| l.starts_with("tangential"))
+            .unwrap()
+            + 1;
+        let e = Tangential::of(&case.contact).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!(
+                "q.toml:{line}: contact.tangential: unknown variant `nope`, expected one of \
+                 `mercury`, `lammps-hooke-history`,"
+            )),
+            "{e}"
+        );
+        assert!(e.ends_with("`objective`"), "{e}");
+    }
+}
