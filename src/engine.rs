@@ -4,8 +4,8 @@
 use crate::case::{self, Case};
 use crate::contact::normal::Clipped;
 use crate::contact::{
-    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, TangentialModel,
-    TangentialVisitor,
+    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, Parameters,
+    TangentialModel, TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
@@ -55,7 +55,7 @@ where
         });
     }
     c.tangential
-        .with_model(c.kt, c.gammat, c.mu, ComposeWith { normal, v })
+        .with_model(&Parameters::of(c), ComposeWith { normal, v })
 }
 
 /// Composes a normal model with the tangential model the registry builds, for a visitor.

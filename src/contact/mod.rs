@@ -10,6 +10,7 @@
 //! P (I receives the opposite).
 
 pub mod normal;
+pub mod parameters;
 pub mod registry;
 pub mod tangential;
 
@@ -17,12 +18,13 @@ use crate::state::History;
 pub use crate::state::PairForce;
 use crate::Vec3;
 pub use normal::{LinearSpringDashpot, NormalModel};
-pub use registry::{Properties, Tangential, TangentialVisitor};
+pub use parameters::Parameters;
+pub use registry::{Geometry, Properties, Tangential, TangentialVisitor};
 pub use tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox,
 };
-pub use tangential::{Frictionless, TangentialModel};
+pub use tangential::{Arms, Frictionless, TangentialModel};
 
 /// Kinematics of one pair in contact, evaluated at the contact point.
 #[derive(Clone, Copy, Debug)]
