@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-pub use crate::contact::Tangential;
+pub use crate::contact::{Normal, Tangential};
 use crate::stability::{self, Direction, Limit, Pair, Spring};
 
 /// Steps per free–free collision time below which a case is accepted with a warning naming the
@@ -228,6 +228,9 @@ pub struct Contact {
     /// Tangential convention (default `mercury`).
     #[serde(default = "default_tangential")]
     pub tangential: Tangential,
+    /// Normal law (default `linear`: the spring–dashpot with absolute damping).
+    #[serde(default = "default_normal")]
+    pub normal: Normal,
     /// Clip the attractive tail of the normal force, fn = max(fn, 0) (default false).
     #[serde(default)]
     pub clip_normal: bool,
@@ -235,6 +238,10 @@ pub struct Contact {
 
 fn default_tangential() -> Tangential {
     Tangential::Mercury
+}
+
+fn default_normal() -> Normal {
+    Normal::Linear
 }
 
 /// `[scene]`: what is in the box.

@@ -1,11 +1,11 @@
 //! Builds a simulation from a case: the contact law is composed here, once, from the parts the
-//! case switches on (friction or not, tangential convention, clipped normal force or not).
+//! case switches on (normal law, clipped or not, friction or not, tangential convention).
 
 use crate::case::{self, Case};
 use crate::contact::normal::Clipped;
 use crate::contact::{
-    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, Parameters,
-    TangentialModel, TangentialVisitor,
+    Composed, ContactLaw, Frictionless, NormalModel, NormalVisitor, Parameters, TangentialModel,
+    TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
 use crate::scene::Scene;
@@ -32,14 +32,23 @@ pub trait LawVisitor {
 /// Composes the contact law of `c` and hands it to `v`. Without friction the law has no
 /// tangential history, torque or spin (model only what the case needs).
 pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> V::Output {
-    let normal = LinearSpringDashpot {
-        kn: c.kn,
-        gamman: c.gamman,
-    };
-    if c.clip_normal {
-        with_tangential(c, Clipped(normal), v)
-    } else {
-        with_tangential(c, normal, v)
+    c.normal.with_model(&Parameters::of(c), ClipThen { c, v })
+}
+
+/// Clips the case's normal model if it asks to, then composes it with its tangential model.
+struct ClipThen<'a, V> {
+    c: &'a case::Contact,
+    v: V,
+}
+
+impl<V: LawVisitor> NormalVisitor for ClipThen<'_, V> {
+    type Output = V::Output;
+    fn visit<N: NormalModel + Clone + 'static>(self, normal: N) -> V::Output {
+        if self.c.clip_normal {
+            with_tangential(self.c, Clipped(normal), self.v)
+        } else {
+            with_tangential(self.c, normal, self.v)
+        }
     }
 }
 

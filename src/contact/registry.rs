@@ -177,13 +177,6 @@ conventions! {
         "The objective reference law: exact rotation with the contact frame, objective slip";
 }
 
-/// The name and description of every convention, in the registry's order (for help texts).
-pub fn listing() -> impl Iterator<Item = (&'static str, &'static str)> {
-    Tangential::ALL
-        .into_iter()
-        .map(|t| (t.name(), t.description()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -246,7 +239,7 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_the_full_radius_conventions_do_not_conserve_angular_momentum() {
-        let names: std::collections::BTreeSet<_> = listing().map(|(n, _)| n).collect();
+        let names: std::collections::BTreeSet<_> = Tangential::ALL.map(Tangential::name).into();
         assert_eq!(names.len(), Tangential::ALL.len());
         for t in [Tangential::LammpsHookeHistory, Tangential::Cundall] {
             assert!(!t.properties().conserves_angular_momentum, "{}", t.name());
