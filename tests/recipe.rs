@@ -75,17 +75,25 @@ fn table(stdout: &str) -> BTreeMap<(String, String), String> {
         .collect()
 }
 
-/// A tiny case: the binary collision with `[contact] normal = "NAME"`, written into `dir`.
-fn collision_case(dir: &Path, normal: &str) -> std::path::PathBuf {
+/// Runs `bin` on a tiny case, the binary collision with `[contact] normal = "NORMAL"`, in a
+/// folder of its own under `dir` named `label`, and returns its output once it succeeded.
+fn run_collision(bin: &Path, dir: &Path, label: &str, normal: &str) -> String {
     let text = std::fs::read_to_string(common::root().join("cases/verify/binary_collision.toml"))
         .unwrap()
         .replace(
             "[contact]\n",
             &format!("[contact]\nnormal = \"{normal}\"\n"),
         );
-    let path = dir.join(format!("{normal}.toml"));
-    std::fs::write(&path, text).unwrap();
-    path
+    let folder = dir.join(label);
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("case.toml"), text).unwrap();
+    let out = scratch::run(bin, &folder, &["run", "case.toml"]);
+    assert!(
+        out.status.success(),
+        "{label}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 /// The state hash a `verdem run` printed.
@@ -199,26 +207,12 @@ fn the_documented_recipes_add_a_tangential_convention_and_a_damping_that_verify_
     let dir = tempfile::tempdir().unwrap();
     let mut hashes = Vec::new();
     for normal in ["linear", "toy-damping"] {
-        let case = collision_case(dir.path(), normal);
-        let out = scratch::run(&bin, dir.path(), &["run", case.to_str().unwrap()]);
-        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-        assert!(
-            out.status.success(),
-            "{normal}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = run_collision(&bin, dir.path(), normal, normal);
         assert!(stdout.contains("run guard: largest overlap"), "{stdout}");
         hashes.push(state_hash(&stdout));
     }
-    let linear = collision_case(dir.path(), "linear");
     let own_bin = Path::new(env!("CARGO_BIN_EXE_verdem"));
-    let own = scratch::run(own_bin, dir.path(), &["run", linear.to_str().unwrap()]);
-    assert!(
-        own.status.success(),
-        "{}",
-        String::from_utf8_lossy(&own.stderr)
-    );
-    let own_hash = state_hash(&String::from_utf8_lossy(&own.stdout));
+    let own_hash = state_hash(&run_collision(own_bin, dir.path(), "own", "linear"));
     assert_eq!(hashes[0], own_hash, "the default law changed with the toys");
     assert_ne!(hashes[1], hashes[0], "the toy damping had no effect");
     eprintln!(
