@@ -121,4 +121,19 @@ mod tests {
         );
         assert_eq!(f, 200.0 + 15.0);
     }
+
+    #[test]
+    fn a_case_names_its_normal_law_linear_by_default_and_an_unknown_one_is_an_error_at_its_line() {
+        use crate::case::Case;
+        let text = include_str!("../../cases/verify/binary_collision.toml");
+        let case = Case::parse(text, "pair.toml").unwrap();
+        assert_eq!(case.contact.normal, Normal::Linear);
+        let named = text.replace("[contact]\n", "[contact]\nnormal = \"linear\"\n");
+        assert_eq!(Case::parse(&named, "pair.toml").unwrap(), case);
+        let unknown = text.replace("[contact]\n", "[contact]\nnormal = \"hertz\"\n");
+        let line = 1 + unknown.lines().position(|l| l.starts_with("normal =")).unwrap();
+        let e = Case::parse(&unknown, "pair.toml").unwrap_err().to_string();
+        let at = format!("pair.toml:{line}: contact.normal: unknown variant `hertz`");
+        assert!(e.contains(&at) && e.contains("`linear`"), "{e}");
+    }
 }
