@@ -131,7 +131,10 @@ mod tests {
         let named = text.replace("[contact]\n", "[contact]\nnormal = \"linear\"\n");
         assert_eq!(Case::parse(&named, "pair.toml").unwrap(), case);
         let unknown = text.replace("[contact]\n", "[contact]\nnormal = \"hertz\"\n");
-        let line = 1 + unknown.lines().position(|l| l.starts_with("normal =")).unwrap();
+        let line = 1 + unknown
+            .lines()
+            .position(|l| l.starts_with("normal ="))
+            .unwrap();
         let e = Case::parse(&unknown, "pair.toml").unwrap_err().to_string();
         let at = format!("pair.toml:{line}: contact.normal: unknown variant `hertz`");
         assert!(e.contains(&at) && e.contains("`linear`"), "{e}");
