@@ -1,4 +1,5 @@
-//! `[contact]`: the contact law's parameters, and the name of its tangential convention.
+//! `[contact]`: the contact law's parameters, and the names of its normal law and tangential
+//! convention.
 
 use serde::Deserialize;
 
@@ -26,6 +27,10 @@ pub struct Contact {
     /// (`contact::named`).
     #[serde(default = "default_tangential")]
     pub tangential: Convention,
+    /// Normal law (default `linear`: the spring–dashpot with absolute damping), as named; the
+    /// contact layer resolves it (`contact::named`).
+    #[serde(default = "default_normal")]
+    pub normal: Convention,
     /// Clip the attractive tail of the normal force, fn = max(fn, 0) (default false).
     #[serde(default)]
     pub clip_normal: bool,
@@ -39,10 +44,18 @@ fn default_tangential() -> Convention {
     }
 }
 
-/// The name of a tangential convention as a case gives it, with where it was read (the file
-/// and the 1-based line of `[contact] tangential`, 0 when not read from a file), so that the
-/// contact layer, which knows the conventions, can refuse an unknown name at its line. Two
-/// are equal when they name the same convention.
+fn default_normal() -> Convention {
+    Convention {
+        name: "linear".into(),
+        file: String::new(),
+        line: 0,
+    }
+}
+
+/// The name of a registry entry (a tangential convention, a normal law) as a case gives it,
+/// with where it was read (the file and the 1-based line of its key, 0 when not read from a
+/// file), so that the contact layer, which knows the registries, can refuse an unknown name at
+/// its line. Two are equal when they name the same entry.
 #[derive(Clone, Debug, Eq)]
 pub struct Convention {
     /// The name (`mercury`, `objective`, …), not checked against the registry here.
@@ -75,7 +88,7 @@ impl<'de> Deserialize<'de> for Convention {
         impl<'de> serde::de::Visitor<'de> for Name {
             type Value = String;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("the name of a tangential convention")
+                f.write_str("the name of a registry entry")
             }
             fn visit_enum<A: serde::de::EnumAccess<'de>>(self, a: A) -> Result<String, A::Error> {
                 use serde::de::VariantAccess;

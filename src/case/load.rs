@@ -97,6 +97,8 @@ impl Case {
         }
         case.contact.tangential.file = file.into();
         case.contact.tangential.line = at.line("contact.tangential");
+        case.contact.normal.file = file.into();
+        case.contact.normal.line = at.line("contact.normal");
         case.warnings = case.validate(&at, purpose)?;
         Ok(case)
     }

@@ -1,7 +1,7 @@
 //! Contact laws composed of small parts: a normal force model and a tangential model (spring,
 //! dashpot and Coulomb cap). A variant is a new part, chosen once when the simulation is built,
 //! never an `if` in the pair loop. The tangential conventions a case can name are listed,
-//! with the properties they claim, in [`registry`].
+//! with the properties they claim, in [`registry`]; the normal laws in [`normal_laws`].
 //!
 //! Conventions (MercuryDPM, `BaseInteraction` and `SlidingFrictionInteraction`; see
 //! `docs/benchmark.md`, "How MercuryDPM computes it"): for a pair, P is the lower index and I
@@ -11,6 +11,8 @@
 
 pub mod named;
 pub mod normal;
+pub mod normal_laws;
+pub mod parameters;
 pub mod registry;
 pub mod tangential;
 
@@ -18,12 +20,14 @@ use crate::state::History;
 pub use crate::state::PairForce;
 use crate::Vec3;
 pub use normal::{LinearSpringDashpot, NormalModel};
-pub use registry::{Properties, Tangential, TangentialVisitor};
+pub use normal_laws::{Normal, NormalVisitor};
+pub use parameters::Parameters;
+pub use registry::{Geometry, Properties, Tangential, TangentialVisitor};
 pub use tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox,
 };
-pub use tangential::{Frictionless, TangentialModel};
+pub use tangential::{Arms, Frictionless, TangentialModel};
 
 /// Kinematics of one pair in contact, evaluated at the contact point.
 #[derive(Clone, Copy, Debug)]

@@ -1,45 +1,66 @@
-//! The tangential convention a case names, resolved against the registry: the case file
-//! holds a name ([`case::Convention`]), the contact layer knows which names are conventions.
+//! The tangential convention and the normal law a case names, resolved against their
+//! registries: the case file holds names ([`case::Convention`]), the contact layer knows which
+//! names are entries.
 
 use std::path::Path;
 use std::sync::LazyLock;
 
 use serde::de::Error as _;
 
-use super::Tangential;
+use super::{Normal, Tangential};
 use crate::case::{self, Case, CaseError};
 
-/// The registry's names, in its order, as serde's messages list a field's choices.
+/// The registries' names, in their order, as serde's messages list a field's choices.
 static NAMES: LazyLock<Vec<&'static str>> =
     LazyLock::new(|| Tangential::ALL.iter().map(|t| t.name()).collect());
+static NORMAL_NAMES: LazyLock<Vec<&'static str>> =
+    LazyLock::new(|| Normal::ALL.iter().map(|n| n.name()).collect());
+
+/// The error `file:line: field: unknown variant …` for a name no entry of `names` bears.
+fn unknown(named: &case::Convention, field: &str, names: &'static [&'static str]) -> CaseError {
+    CaseError {
+        file: named.file.clone(),
+        line: named.line,
+        field: field.into(),
+        msg: serde::de::value::Error::unknown_variant(named.name(), names).to_string(),
+    }
+}
 
 impl Tangential {
     /// The convention `contact.tangential` names, or the error `file:line:
     /// contact.tangential: unknown variant …` at the line that names it.
     pub fn of(contact: &case::Contact) -> Result<Tangential, CaseError> {
         let named = &contact.tangential;
-        Tangential::named(named.name()).ok_or_else(|| CaseError {
-            file: named.file.clone(),
-            line: named.line,
-            field: "contact.tangential".into(),
-            msg: serde::de::value::Error::unknown_variant(named.name(), &NAMES).to_string(),
-        })
+        Tangential::named(named.name()).ok_or_else(|| unknown(named, "contact.tangential", &NAMES))
     }
 }
 
-/// Reads a case file ([`Case::load`]) and refuses a tangential convention the registry does
-/// not know, as for a command that uses the case before (or without) building its law.
-pub fn load(path: &Path) -> Result<Case, CaseError> {
-    let case = Case::load(path)?;
+impl Normal {
+    /// The normal law `contact.normal` names, or the error `file:line: contact.normal: unknown
+    /// variant …` at the line that names it.
+    pub fn of(contact: &case::Contact) -> Result<Normal, CaseError> {
+        let named = &contact.normal;
+        Normal::named(named.name()).ok_or_else(|| unknown(named, "contact.normal", &NORMAL_NAMES))
+    }
+}
+
+/// Refuses a case whose normal law or tangential convention no registry holds.
+fn resolves(case: Case) -> Result<Case, CaseError> {
+    Normal::of(&case.contact)?;
     Tangential::of(&case.contact)?;
     Ok(case)
 }
 
-/// [`Case::load_for_prescribed_motion`], refusing an unknown tangential convention as [`load`].
+/// Reads a case file ([`Case::load`]) and refuses a normal law or tangential convention the
+/// registries do not know, as for a command that uses the case before (or without) building
+/// its law.
+pub fn load(path: &Path) -> Result<Case, CaseError> {
+    resolves(Case::load(path)?)
+}
+
+/// [`Case::load_for_prescribed_motion`], refusing an unknown name as [`load`].
 pub fn load_for_prescribed_motion(path: &Path) -> Result<Case, CaseError> {
-    let case = Case::load_for_prescribed_motion(path)?;
-    Tangential::of(&case.contact)?;
-    Ok(case)
+    resolves(Case::load_for_prescribed_motion(path)?)
 }
 
 /// The name of `t`, for a case whose convention is set in code (read from no file).

@@ -1,12 +1,13 @@
 //! The registry of tangential conventions: one entry per convention a case can name, giving
-//! the name used in case files and on the command line, the tangential model (a type built by
-//! `new(kt, gammat, mu)`), the properties it claims and a one-line description. The case
-//! parser, the law composition, the verification gates and the command line's help all read
-//! this table: adding a convention is one entry here, plus a file of parts under
+//! the name used in case files and on the command line, how its tangential model is built from
+//! the case's contact [`Parameters`], the properties it claims and a one-line description. The
+//! case parser, the law composition, the verification gates and the command line's help all
+//! read this table: adding a convention is one entry here, plus a file of parts under
 //! [`super::tangential`] if it needs new ones.
 //!
-//! Only the properties an entry lists are true; whether its torques conserve angular momentum
-//! follows from its model's lever arms ([`TangentialModel::FULL_RADIUS_LEVER`]).
+//! Only the properties an entry lists are claimed; what follows from its model's lever arms
+//! ([`Geometry`]: whether its torques conserve angular momentum, what the verification's
+//! theory predicts for it) is read from the model's parts.
 
 use serde::Deserialize;
 
@@ -14,7 +15,8 @@ use super::tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox, YadeViscEl,
 };
-use super::TangentialModel;
+use super::tangential::Arms;
+use super::{Parameters, TangentialModel};
 
 /// What a convention claims about its physics: the verification gates hold each convention to
 /// the rows its properties promise and show the others as documentation of its defects.
@@ -45,6 +47,33 @@ impl Properties {
     };
 }
 
+/// The lever arms of a convention's slip and torques, read from its model's parts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Geometry {
+    /// The arms along which the spins enter the slip ([`TangentialModel::SLIP_ARMS`]).
+    pub slip: Arms,
+    /// Whether the slip scales the centres' relative velocity by α = (R_P + R_I)/|r|
+    /// ([`TangentialModel::SLIP_SCALES_CENTRES`]).
+    pub slip_scales_centres: bool,
+    /// The arms of the torques ([`TangentialModel::FULL_RADIUS_LEVER`]).
+    pub torque: Arms,
+}
+
+impl Geometry {
+    /// The geometry of the model that `build` makes (never called: only its type is read).
+    fn of<T: TangentialModel>(_build: impl Fn(&Parameters) -> T) -> Geometry {
+        Geometry {
+            slip: T::SLIP_ARMS,
+            slip_scales_centres: T::SLIP_SCALES_CENTRES,
+            torque: if T::FULL_RADIUS_LEVER {
+                Arms::FullRadius
+            } else {
+                Arms::HalfOverlap
+            },
+        }
+    }
+}
+
 /// Something done with a tangential model, whichever concrete type the convention names (its
 /// history the `Vec3` the solver stores).
 pub trait TangentialVisitor {
@@ -54,10 +83,12 @@ pub trait TangentialVisitor {
 }
 
 /// Generates [`Tangential`] and its table from the entries
-/// `Variant = "name", Model, [properties], "description";`.
+/// `Variant = "name", |p| model, [properties], "description";`, where `model` builds the
+/// convention's tangential model from `p: &Parameters`.
 macro_rules! conventions {
     ($(
-        $variant:ident = $name:literal, $model:ty, [$($property:ident),*], $description:literal;
+        $variant:ident = $name:literal, |$p:ident| $build:expr, [$($property:ident),*],
+            $description:literal;
     )*) => {
         /// A tangential contact convention, named in a case's `[contact] tangential`.
         #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
@@ -92,31 +123,35 @@ macro_rules! conventions {
                 }
             }
 
-            /// What the convention claims (see [`Properties`]).
-            pub const fn properties(self) -> Properties {
+            /// The lever arms of the convention's slip and torques (see [`Geometry`]).
+            pub fn geometry(self) -> Geometry {
                 match self {
-                    $(Tangential::$variant => {
-                        let mut p = Properties::NONE;
-                        $(p.$property = true;)*
-                        p.conserves_angular_momentum =
-                            !<$model as TangentialModel>::FULL_RADIUS_LEVER;
-                        p
-                    })*
+                    $(Tangential::$variant => Geometry::of(|$p: &Parameters| $build),)*
                 }
             }
 
-            /// Builds the convention's tangential model with spring `kt` (force/length),
-            /// dashpot `gammat` (mass/time, absolute) and Coulomb coefficient `mu`, and hands
-            /// it to `v`.
-            pub fn with_model<V: TangentialVisitor>(
-                self,
-                kt: f64,
-                gammat: f64,
-                mu: f64,
-                v: V,
-            ) -> V::Output {
+            /// What the convention claims (see [`Properties`]), and whether its torques conserve
+            /// angular momentum (their arms reach the contact point).
+            pub fn properties(self) -> Properties {
+                let mut p = match self {
+                    $(Tangential::$variant => Properties {
+                        $($property: true,)*
+                        ..Properties::NONE
+                    },)*
+                };
+                p.conserves_angular_momentum = self.geometry().torque == Arms::HalfOverlap;
+                p
+            }
+
+            /// Builds the convention's tangential model from the contact parameters `params`
+            /// (its spring kt in force/length, dashpot γt in mass/time, absolute, and Coulomb
+            /// coefficient μ, as the entry reads them) and hands it to `v`.
+            pub fn with_model<V: TangentialVisitor>(self, params: &Parameters, v: V) -> V::Output {
                 match self {
-                    $(Tangential::$variant => v.visit(<$model>::new(kt, gammat, mu)),)*
+                    $(Tangential::$variant => {
+                        let $p = params;
+                        v.visit($build)
+                    })*
                 }
             }
         }
@@ -124,29 +159,22 @@ macro_rules! conventions {
 }
 
 conventions! {
-    Mercury = "mercury", MercurySlidingFriction, [],
+    Mercury = "mercury", |p| MercurySlidingFriction::new(p.kt, p.gammat, p.mu), [],
         "MercuryDPM's sliding friction (the benchmark default): rate-form spring, cap on spring + dashpot";
-    LammpsHookeHistory = "lammps-hooke-history", LammpsHookeHistory, [],
+    LammpsHookeHistory = "lammps-hooke-history", |p| LammpsHookeHistory::new(p.kt, p.gammat, p.mu), [],
         "LAMMPS `gran/hooke/history`: increment then project, full-radius lever arms";
-    LammpsGranular = "lammps-granular", LammpsGranular, [],
+    LammpsGranular = "lammps-granular", |p| LammpsGranular::new(p.kt, p.gammat, p.mu), [],
         "LAMMPS `granular … tangential linear_history`: project and rescale, then increment";
-    Liggghts = "liggghts", Liggghts, [drops_dashpot_while_sliding],
+    Liggghts = "liggghts", |p| Liggghts::new(p.kt, p.gammat, p.mu), [drops_dashpot_while_sliding],
         "LIGGGHTS 3.8 `tangential history`: project; cap on the spring only, no dashpot while sliding";
-    Yade = "yade", YadeApprox, [twists_spring],
+    Yade = "yade", |p| YadeApprox::new(p.kt, p.gammat, p.mu), [twists_spring],
         "Yade's first-order rotation of the spring with the objective slip";
-    YadeViscEl = "yade-viscel", YadeViscEl, [twists_spring, drops_dashpot_while_sliding],
+    YadeViscEl = "yade-viscel", |p| YadeViscEl::new(p.kt, p.gammat, p.mu), [twists_spring, drops_dashpot_while_sliding],
         "Yade `Law2_ScGeom_ViscElPhys_Basic`: first-order rotation, cap on the spring only, no dashpot while sliding";
-    Cundall = "cundall", Cundall1979, [],
+    Cundall = "cundall", |p| Cundall1979::new(p.kt, p.gammat, p.mu), [],
         "Cundall & Strack 1979: no frame update at all";
-    Objective = "objective", Objective, [objective, twists_spring],
+    Objective = "objective", |p| Objective::new(p.kt, p.gammat, p.mu), [objective, twists_spring],
         "The objective reference law: exact rotation with the contact frame, objective slip";
-}
-
-/// The name and description of every convention, in the registry's order (for help texts).
-pub fn listing() -> impl Iterator<Item = (&'static str, &'static str)> {
-    Tangential::ALL
-        .into_iter()
-        .map(|t| (t.name(), t.description()))
 }
 
 #[cfg(test)]
@@ -193,7 +221,14 @@ mod tests {
     #[test]
     fn every_convention_accounts_for_the_work_its_tangential_force_takes() {
         for t in Tangential::ALL {
-            let missing = t.with_model(1000.0, 5.0, 0.3, Unaccounted { steps: 500 });
+            let params = Parameters {
+                kn: 1e4,
+                gamman: 1.0,
+                kt: 1000.0,
+                gammat: 5.0,
+                mu: 0.3,
+            };
+            let missing = t.with_model(&params, Unaccounted { steps: 500 });
             assert!(
                 missing.abs() < 2e-3,
                 "{}: {missing:e} of the work",
@@ -204,13 +239,19 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_the_full_radius_conventions_do_not_conserve_angular_momentum() {
-        let names: std::collections::BTreeSet<_> = listing().map(|(n, _)| n).collect();
+        let names: std::collections::BTreeSet<_> = Tangential::ALL.map(Tangential::name).into();
         assert_eq!(names.len(), Tangential::ALL.len());
-        let lossy: Vec<_> = Tangential::ALL
-            .into_iter()
-            .filter(|t| !t.properties().conserves_angular_momentum)
-            .collect();
-        assert_eq!(lossy, [Tangential::LammpsHookeHistory, Tangential::Cundall]);
+        for t in [Tangential::LammpsHookeHistory, Tangential::Cundall] {
+            assert!(!t.properties().conserves_angular_momentum, "{}", t.name());
+        }
+        for t in [
+            Tangential::Mercury,
+            Tangential::LammpsGranular,
+            Tangential::Objective,
+        ] {
+            assert!(t.properties().conserves_angular_momentum, "{}", t.name());
+        }
         assert!(Tangential::Objective.properties().objective);
+        assert!(!Tangential::Mercury.properties().objective);
     }
 }

@@ -1,14 +1,14 @@
 //! The engine: the law-independent face of a simulation ([`Engine`], what the run loop and the
 //! tools drive) and how one is built from a case ([`build`]): the contact law is composed here,
-//! once, from the parts the case switches on (friction or not, tangential convention, clipped
-//! normal force or not).
+//! once, from the parts the case switches on (normal law, clipped or not, friction or not,
+//! tangential convention).
 
 use super::guard::Failure;
 use super::{energy, Core, Flows, Params, Reading, Simulation, StageTimes, State};
 use crate::case::{self, Case, CaseError};
 use crate::contact::normal::Clipped;
 use crate::contact::{
-    Composed, ContactLaw, Frictionless, LinearSpringDashpot, NormalModel, Tangential,
+    Composed, ContactLaw, Frictionless, Normal, NormalModel, NormalVisitor, Parameters, Tangential,
     TangentialModel, TangentialVisitor,
 };
 use crate::neighbor::NeighborBuilder;
@@ -169,20 +169,33 @@ pub trait LawVisitor {
     fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Self::Output;
 }
 
-/// Composes the contact law of `c` and hands it to `v`; an error when `c` names no
-/// tangential convention ([`Tangential::of`]), with or without friction. Without friction the
-/// law has no tangential history, torque or spin (model only what the case needs).
+/// Composes the contact law of `c` and hands it to `v`: the normal law the registry builds
+/// (clipped if the case asks), then the tangential convention; an error when `c` names no
+/// normal law ([`Normal::of`]) or no tangential convention ([`Tangential::of`]), with or
+/// without friction. Without friction the law has no tangential history, torque or spin
+/// (model only what the case needs).
 pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> Result<V::Output, CaseError> {
+    let normal = Normal::of(c)?;
     let tangential = Tangential::of(c)?;
-    let normal = LinearSpringDashpot {
-        kn: c.kn,
-        gamman: c.gamman,
-    };
-    Ok(if c.clip_normal {
-        with_tangential(c, tangential, Clipped(normal), v)
-    } else {
-        with_tangential(c, tangential, normal, v)
-    })
+    Ok(normal.with_model(&Parameters::of(c), ClipThen { c, tangential, v }))
+}
+
+/// Clips the case's normal model if it asks to, then composes it with its tangential model.
+struct ClipThen<'a, V> {
+    c: &'a case::Contact,
+    tangential: Tangential,
+    v: V,
+}
+
+impl<V: LawVisitor> NormalVisitor for ClipThen<'_, V> {
+    type Output = V::Output;
+    fn visit<N: NormalModel + Clone + 'static>(self, normal: N) -> V::Output {
+        if self.c.clip_normal {
+            with_tangential(self.c, self.tangential, Clipped(normal), self.v)
+        } else {
+            with_tangential(self.c, self.tangential, normal, self.v)
+        }
+    }
 }
 
 fn with_tangential<N, V>(c: &case::Contact, tangential: Tangential, normal: N, v: V) -> V::Output
@@ -196,7 +209,7 @@ where
             tangential: Frictionless,
         });
     }
-    tangential.with_model(c.kt, c.gammat, c.mu, ComposeWith { normal, v })
+    tangential.with_model(&Parameters::of(c), ComposeWith { normal, v })
 }
 
 /// Composes a normal model with the tangential model the registry builds, for a visitor.

@@ -28,7 +28,7 @@ use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
 use super::ratchet::net_work;
 use super::{row_abs, Row, Subject};
 use crate::case::Case;
-use crate::contact::Tangential;
+use crate::contact::{Arms, Tangential};
 use crate::verify::kinematics::{pair_of, MotionRow};
 use crate::Vec3;
 
@@ -58,21 +58,14 @@ impl Rotation {
 }
 
 /// The factor c of the theory's residual c·kt·θ·|δ2 − δ1| for a convention's slip under a
-/// rotation (this module's head): 1/2 for lever arms R − δ/2 under a spin, 1 for full radii
-/// under a rigid rotation, 0 otherwise. The slips are those of `contact::tangential`'s
-/// conventions (`HalfOverlapSlip`, `FullRadiusSlip`, the objective slips).
+/// rotation (this module's head), from the lever arms of its slip ([`Tangential::geometry`]):
+/// 1/2 for lever arms R − δ/2 under a spin, 1 for full radii without the objective scaling of
+/// the centres' velocity under a rigid rotation, 0 otherwise.
 pub fn theory_factor(conv: Tangential, rotation: Rotation) -> f64 {
-    let half_overlap = matches!(
-        conv,
-        Tangential::Mercury | Tangential::Liggghts | Tangential::YadeViscEl
-    );
-    let full_radius = matches!(
-        conv,
-        Tangential::LammpsHookeHistory | Tangential::LammpsGranular | Tangential::Cundall
-    );
+    let g = conv.geometry();
     match rotation {
-        Rotation::Spin if half_overlap => 0.5,
-        Rotation::Rigid if full_radius => 1.0,
+        Rotation::Spin if g.slip == Arms::HalfOverlap => 0.5,
+        Rotation::Rigid if g.slip == Arms::FullRadius && !g.slip_scales_centres => 1.0,
         _ => 0.0,
     }
 }
@@ -186,18 +179,17 @@ pub fn loads(case: &Case, rotation: Rotation) -> anyhow::Result<Loads> {
 }
 
 /// Whether a convention's torques use the lever arms its slip uses (R − δ/2 for both, or R
-/// for both), so that the work of the torques is that of the spring. The objective slips use R
+/// for both) and its centres exchange the force its slip is conjugate to (the slip does not
+/// scale their velocity), so that the work of the force and torques is that of the spring
+/// (from [`Tangential::geometry`]). The objective slips use R
 /// (McNamara et al.'s form) with torques to the contact point, R − δ/2, as LAMMPS `granular`
 /// does with its full-radius slip: a spin cycle then does net work −kt·R·θ²·(δ2 − δ1)/4 on
 /// the spheres though the force returns to zero. McNamara et al. make the pair exchange α·Ft
 /// at the centres (α = (R_1 + R_2)/d) with torques R × Ft, conjugate to their slip, which
 /// keeps both the work and the angular momentum.
 pub fn torques_conjugate_to_slip(conv: Tangential) -> bool {
-    match conv {
-        Tangential::Mercury | Tangential::Liggghts | Tangential::YadeViscEl => true,
-        Tangential::LammpsHookeHistory | Tangential::Cundall => true,
-        Tangential::LammpsGranular | Tangential::Yade | Tangential::Objective => false,
-    }
+    let g = conv.geometry();
+    g.torque == g.slip && !g.slip_scales_centres
 }
 
 /// The cycles' names, one per [`Rotation`]: the variants of the verification table's case.

@@ -29,6 +29,16 @@ use cap::Cap;
 use frame::FrameUpdate;
 use slip::Slip;
 
+/// The lever arms from a sphere's centre to its contact along which a slip takes the spins or a
+/// torque takes the force.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arms {
+    /// To the contact point in the middle of the overlap, R − δ/2: they change with the overlap.
+    HalfOverlap,
+    /// The full radii along the normal, −R_P n and R_I n: constant.
+    FullRadius,
+}
+
 /// A tangential model. `fn_signed` is the signed normal force of the same contact; `xi` is the
 /// contact's history, updated in place over the step `dt`.
 pub trait TangentialModel: Send + Sync {
@@ -40,6 +50,11 @@ pub trait TangentialModel: Send + Sync {
     /// True when the torques use the full radii as lever arms (−R_P n, R_I n) instead of the
     /// arms to the contact point in the middle of the overlap.
     const FULL_RADIUS_LEVER: bool = false;
+    /// The lever arms along which the spins enter the model's slip.
+    const SLIP_ARMS: Arms;
+    /// Whether the slip scales the centres' relative velocity by α = (R_P + R_I)/|r| (the
+    /// objective slip).
+    const SLIP_SCALES_CENTRES: bool;
     /// The tangential force on P (force units) for a contact with kinematics `k`, signed normal
     /// force `fn_signed` (positive repulsive), history `xi` (updated in place) and time step
     /// `dt` (time).
@@ -74,6 +89,9 @@ pub struct Frictionless;
 impl TangentialModel for Frictionless {
     type History = Vec3;
     const ACTIVE: bool = false;
+    /// No slip is formed; the contact point's arms, as for the torques it does not make.
+    const SLIP_ARMS: Arms = Arms::HalfOverlap;
+    const SLIP_SCALES_CENTRES: bool = false;
     #[inline(always)]
     fn force(&self, _: &PairKinematics, _: f64, _: &mut Vec3, _: f64) -> Vec3 {
         Vec3::zeros()
@@ -125,6 +143,8 @@ impl<S: Slip, U: FrameUpdate, C: Cap, const FULL_LEVER: bool> TangentialModel
     type History = Vec3;
     const ACTIVE: bool = true;
     const FULL_RADIUS_LEVER: bool = FULL_LEVER;
+    const SLIP_ARMS: Arms = S::ARMS;
+    const SLIP_SCALES_CENTRES: bool = S::SCALES_CENTRES;
 
     #[inline(always)]
     fn force(&self, k: &PairKinematics, fn_signed: f64, xi: &mut Vec3, dt: f64) -> Vec3 {

@@ -1,13 +1,18 @@
 //! Slips: how the relative tangential velocity at the contact is formed. The slip is the
 //! velocity of P's material point at the contact relative to I's, tangential part.
 
-use super::previous_normal;
+use super::{previous_normal, Arms};
 use crate::contact::PairKinematics;
 use crate::Vec3;
 
 /// How the relative tangential velocity at the contact is formed (over the step `dt` that
 /// ends at the current positions).
 pub trait Slip: Send + Sync {
+    /// The lever arms along which the spins enter the slip.
+    const ARMS: Arms;
+    /// Whether the centres' relative velocity enters scaled by α = (R_P + R_I)/|r| (the
+    /// objective slip), so that a rigid rotation of the pair leaves no slip.
+    const SCALES_CENTRES: bool;
     /// The tangential relative velocity of P with respect to I at the contact (length/time),
     /// perpendicular to the normal (unit, from I to P); `dt` is the time step (time).
     fn slip(k: &PairKinematics, dt: f64) -> Vec3;
@@ -19,6 +24,8 @@ pub trait Slip: Send + Sync {
 pub struct HalfOverlapSlip;
 
 impl Slip for HalfOverlapSlip {
+    const ARMS: Arms = Arms::HalfOverlap;
+    const SCALES_CENTRES: bool = false;
     #[inline(always)]
     fn slip(k: &PairKinematics, _: f64) -> Vec3 {
         k.vt
@@ -32,6 +39,8 @@ impl Slip for HalfOverlapSlip {
 pub struct FullRadiusSlip;
 
 impl Slip for FullRadiusSlip {
+    const ARMS: Arms = Arms::FullRadius;
+    const SCALES_CENTRES: bool = false;
     #[inline(always)]
     fn slip(k: &PairKinematics, _: f64) -> Vec3 {
         let v = k.v_centres - (k.rad_p * k.w_p + k.rad_i * k.w_i).cross(&k.n);
@@ -48,6 +57,8 @@ impl Slip for FullRadiusSlip {
 pub struct ObjectiveSlip;
 
 impl Slip for ObjectiveSlip {
+    const ARMS: Arms = Arms::FullRadius;
+    const SCALES_CENTRES: bool = true;
     #[inline(always)]
     fn slip(k: &PairKinematics, _: f64) -> Vec3 {
         objective_slip(k, k.n)
@@ -70,6 +81,8 @@ fn objective_slip(k: &PairKinematics, m: Vec3) -> Vec3 {
 pub struct MidpointObjectiveSlip;
 
 impl Slip for MidpointObjectiveSlip {
+    const ARMS: Arms = Arms::FullRadius;
+    const SCALES_CENTRES: bool = true;
     #[inline(always)]
     fn slip(k: &PairKinematics, dt: f64) -> Vec3 {
         let m = (previous_normal(k, dt) + k.n).normalize();
