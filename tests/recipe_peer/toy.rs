@@ -9,7 +9,8 @@ use std::time::Instant;
 use anyhow::{bail, ensure, Context};
 
 use super::{Frame, Installed, Launch, Peer, Run, Save};
-use crate::case::{Case, Tangential};
+use crate::case::Case;
+use crate::contact::Tangential;
 use crate::child::{self, OnParentDeath};
 use crate::io::{atomic, mercury};
 use crate::state::{Contact, Snapshot};
