@@ -89,6 +89,10 @@ pub struct Subject<'a> {
     /// row's expected value (a documented defect), the subject is held to verdem's number
     /// instead, with the same tolerance.
     pub gated_as: Option<Tangential>,
+    /// The convention whose lever arms and slip the rows' expected values use, where they
+    /// differ between conventions: verdem's own law's, or the one a program claims; none for a
+    /// program that claims none (those rows then allow the spread between conventions).
+    pub declared: Option<Tangential>,
     /// Whether a row it fails at the motion's step is judged again at finer steps
     /// ([`refinement`]): for a program, whose time discretisation is its own.
     pub refines: bool,
@@ -103,6 +107,7 @@ impl Subject<'static> {
             tangential: conv,
             properties: conv.properties(),
             gated_as: None,
+            declared: Some(conv),
             refines: false,
             driver: &OWN,
         }
@@ -120,6 +125,7 @@ impl<'a> Subject<'a> {
             tangential: claim.unwrap_or(Tangential::Objective),
             properties: claim.unwrap_or(Tangential::Objective).properties(),
             gated_as: claim,
+            declared: claim,
             refines: true,
             driver,
         }
@@ -132,6 +138,7 @@ impl<'a> Subject<'a> {
             tangential: self.tangential,
             properties: self.properties,
             gated_as: self.gated_as,
+            declared: self.declared,
             refines: self.refines,
             driver,
         }

@@ -81,21 +81,25 @@ pub fn judged_by_refinement(at: Row, half: &Row, quarter: &Row) -> Row {
         "none (the error does not fall at each refinement)".into(),
         |p| format!("{p:.2}"),
     );
-    let (outcome, verdict) = match c.extrapolated {
-        Some(e) if c.vanishes(tolerance) => (
+    let (outcome, verdict) = match (c.order, c.extrapolated) {
+        (_, Some(e)) if c.vanishes(tolerance) => (
             Outcome::Pass,
             format!("error extrapolated to dt -> 0: {e:.1e}, within the tolerance: converges"),
         ),
-        Some(e) => (
+        (_, Some(e)) => (
             Outcome::Fail,
             format!(
                 "error extrapolated to dt -> 0: {e:.1e}, beyond the tolerance: converges to a \
                  wrong value"
             ),
         ),
-        None => (
+        (Some(_), None) => (
             Outcome::Fail,
-            format!("below {MIN_ORDER}: the error does not vanish under refinement"),
+            format!("below {MIN_ORDER}: the error does not vanish at first order"),
+        ),
+        (None, None) => (
+            Outcome::Fail,
+            "the error does not vanish under refinement".into(),
         ),
     };
     let text = format!(
