@@ -84,3 +84,64 @@ fn a_law_with_mu_off_by_a_tenth_of_a_percent_fails_the_coulomb_rows_of_every_con
     assert_eq!(n, 4 * verdem::contact::Tangential::ALL.len());
     assert_eq!(failed(&rows, impulse, "").len(), n, "{rows:#?}");
 }
+
+/// verdem's law of the case with one parameter changed: a wrong law behind the prescribed
+/// motions, judged against the answers of the case's own values.
+struct Wrong(fn(&mut Case));
+
+impl verdem::verify::driver::MotionDriver for Wrong {
+    fn drive(
+        &self,
+        case: &Case,
+        motion: &[verdem::verify::kinematics::MotionRow],
+    ) -> anyhow::Result<Vec<verdem::verify::kinematics::ForceRow>> {
+        let mut wrong = case.clone();
+        (self.0)(&mut wrong);
+        verdem::verify::driver::OWN.drive(&wrong, motion)
+    }
+    fn name(&self) -> String {
+        "wrong".into()
+    }
+}
+
+/// The tangential-history rows of every convention's law, driven by `driver`.
+fn histories(driver: &dyn verdem::verify::driver::MotionDriver) -> Vec<Row> {
+    let base =
+        Case::load_for_prescribed_motion(&common::root().join("cases/verify/objectivity.toml"))
+            .unwrap();
+    let mut rows = Vec::new();
+    for conv in verdem::contact::Tangential::ALL {
+        let subject = verdem::verify::Subject::own(conv).driven_by(driver);
+        for label in verdem::verify::histories::HISTORIES {
+            rows.extend(verdem::verify::histories::history_rows(&base, &subject, label).unwrap());
+        }
+    }
+    rows
+}
+
+#[test]
+fn a_law_with_kt_kn_or_mu_off_by_1e_4_fails_a_history_row_of_every_convention() {
+    // every gating row passes with the case's own values (the peers' known defects aside)
+    let right = histories(&verdem::verify::driver::OWN);
+    assert!(right.iter().all(|r| r.passed() || !r.gate), "{right:#?}");
+    for (parameter, change) in [
+        (
+            "kt",
+            (|c: &mut Case| c.contact.kt *= 1.0001) as fn(&mut Case),
+        ),
+        ("kn", |c: &mut Case| c.contact.kn *= 1.0001),
+        ("mu", |c: &mut Case| c.contact.mu *= 1.0001),
+    ] {
+        let rows = histories(&Wrong(change));
+        assert_eq!(rows.len(), right.len());
+        for conv in verdem::contact::Tangential::ALL {
+            let label = format!("tangential {} ", conv.name());
+            let failed: Vec<_> = rows
+                .iter()
+                .zip(&right)
+                .filter(|(r, o)| r.case.starts_with(&label) && o.passed() && !r.passed())
+                .collect();
+            assert!(!failed.is_empty(), "{parameter} {}: {rows:#?}", conv.name());
+        }
+    }
+}

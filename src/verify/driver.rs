@@ -55,6 +55,33 @@ impl MotionDriver for Own {
     }
 }
 
+/// `inner` driven through the same motion at a finer step: `fine` rows per row of the motion
+/// ([`kinematics::refine`], the refined motion is what `inner` reads, e.g. in its MOTION.csv),
+/// with the forces of the motion's own rows returned (every `fine`-th row of `inner`'s).
+pub struct Refined<'a> {
+    pub inner: &'a dyn MotionDriver,
+    pub fine: usize,
+}
+
+impl MotionDriver for Refined<'_> {
+    fn drive(&self, case: &Case, motion: &[MotionRow]) -> anyhow::Result<Vec<ForceRow>> {
+        let rows = kinematics::refine(motion, self.fine);
+        let forces = self.inner.drive(case, &rows)?;
+        anyhow::ensure!(
+            forces.len() == rows.len(),
+            "{}: {} rows of forces for {} rows of the refined motion",
+            self.inner.name(),
+            forces.len(),
+            rows.len()
+        );
+        Ok(forces.into_iter().step_by(self.fine).collect())
+    }
+
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+}
+
 /// An external program with the command-line interface of `verdem kinematics`: invoked as
 /// `CMD CASE.toml MOTION.csv --out FORCES.csv` through `sh -c` (so `cmd` may hold arguments
 /// and quotes), in the current directory, with the files in a fresh folder under `scratch`.

@@ -8,14 +8,41 @@
 //! point by l₂φ, l₂ = R₂ − δ/2 the arm to the contact point in the middle of the overlap, and
 //! the spring pushes sphere 2 along t × n with kt·l₂·φ, up to the Coulomb limit mu·fn. Both
 //! torques about the spheres' centres oppose the spin: −l·|Ft| along t. Conventions that take
-//! the full radius as slip arm or lever arm differ from these by δ/(2R) relative: the rows
-//! that depend on the arm have the tolerance δ/R.
+//! the full radius as slip arm or lever arm differ from these by δ/(2R) relative: for a
+//! subject whose convention is known ([`Subject::declared`]) the rows that depend on the arm
+//! expect that convention's own arms ([`arms`]) to round-off, so that a stiffness off by 1e-4
+//! fails; for a program that names none they allow the spread δ/R between conventions.
 
 use super::objectivity::{spin_sphere_2, tangent_axis};
 use super::{row, row_abs, Row, Subject};
 use crate::case::Case;
+use crate::contact::Tangential;
 use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
+
+/// The arms a convention uses when sphere 2 spins about a tangent axis at a fixed normal, as
+/// multiples of R2 − δ/2 (the arm to the contact point in the middle of the overlap): its
+/// slip arm (how far the contact point slides per radian) and its torque arm. Lever arms to
+/// the contact point, R − δ/2, in the slip of MercuryDPM, LIGGGHTS and Yade's ViscEl law; full
+/// radii in the slip of LAMMPS, Cundall, Yade's and the objective law (`contact::tangential`:
+/// `HalfOverlapSlip`, `FullRadiusSlip`, the objective slips). Full radii in the torques of
+/// LAMMPS `gran/hooke/history` and Cundall, R − δ/2 in the others.
+pub fn arms(conv: Tangential, radius: f64, delta: f64) -> (f64, f64) {
+    let full = radius / (radius - 0.5 * delta);
+    let slip = match conv {
+        Tangential::Mercury | Tangential::Liggghts | Tangential::YadeViscEl => 1.0,
+        Tangential::LammpsHookeHistory
+        | Tangential::LammpsGranular
+        | Tangential::Yade
+        | Tangential::Cundall
+        | Tangential::Objective => full,
+    };
+    let torque = match conv {
+        Tangential::LammpsHookeHistory | Tangential::Cundall => full,
+        _ => 1.0,
+    };
+    (slip, torque)
+}
 
 /// The histories, by their names in the table.
 pub const HISTORIES: [&str; 3] = ["load-unload", "coulomb limit", "contact loss"];
@@ -68,7 +95,16 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
     let t = tangent_axis(n);
     let along = t.cross(&n);
     let lever = [radius[0] - 0.5 * delta, radius[1] - 0.5 * delta];
-    let arm_tol = delta / radius[1];
+    // the expected slip and torque arms (in units of R − δ/2) and their tolerance: the
+    // convention's own to round-off, or the spread between conventions
+    let (slip_arm, torque_arm, arm_tol) = match subject.declared {
+        Some(conv) => {
+            let (slip, torque2) = arms(conv, radius[1], delta);
+            let (_, torque1) = arms(conv, radius[0], delta);
+            (slip, [torque1, torque2], 1e-9)
+        }
+        None => (1.0, [1.0; 2], delta / radius[1]),
+    };
     // the spin of sphere 2 that loads the spring to the force `force`
     let spin = |force: f64| force / (c.kt * lever[1]);
     let mut rows = vec![MotionRow {
@@ -94,7 +130,7 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                 row(
                     &name,
                     "F2.(t x n) / (kt l2 phi)",
-                    1.0,
+                    slip_arm,
                     p.f[1].dot(&along) / (0.5 * limit),
                     arm_tol,
                 ),
@@ -117,14 +153,14 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                 row(
                     &name,
                     "T1.t / (l1 |Ft|)",
-                    -1.0,
+                    -torque_arm[0],
                     p.torque[0].dot(&t) / (lever[0] * ft),
                     arm_tol,
                 ),
                 row(
                     &name,
                     "T2.t / (l2 |Ft|)",
-                    -1.0,
+                    -torque_arm[1],
                     p.torque[1].dot(&t) / (lever[1] * ft),
                     arm_tol,
                 ),
@@ -155,7 +191,7 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                 row_abs(
                     &name,
                     "|Ft| / (mu fn) back by mu fn/kt",
-                    0.0,
+                    slip_arm - 1.0,
                     ft2(&f[f.len() - 1], n) / limit,
                     arm_tol,
                 ),

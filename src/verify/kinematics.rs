@@ -421,6 +421,59 @@ pub fn parse_forces_lines(file: &str, text: &str) -> Result<Vec<(usize, ForceRow
         .collect())
 }
 
+/// The same motion as `rows` with `fine` rows per row (time step Δt/`fine`): row k of `rows`
+/// is row k·`fine` of the result, unchanged. Row k's velocities are those of the step
+/// [t_(k−1), t_k] (as every prescribed motion of the verification writes them), and between
+/// two rows each sphere moves as that step's rigid motion: its orientation turns at the
+/// constant rate of q_k q_(k−1)⁻¹ (a slerp), its centre along the circular arc from x_(k−1) to
+/// x_k that ends with the velocity v_k (a straight line where v_k is along the chord or zero),
+/// at constant speed; the rows in between carry the spin w_k and the velocity of the arc. A
+/// rigid rotation, a spin in place, an orbit and a straight press are thus refined exactly.
+pub fn refine(rows: &[MotionRow], fine: usize) -> Vec<MotionRow> {
+    let Some(first) = rows.first() else {
+        return Vec::new();
+    };
+    let mut out = Vec::with_capacity((rows.len() - 1) * fine + 1);
+    out.push(*first);
+    for pair in rows.windows(2) {
+        let (from, to) = (&pair[0], &pair[1]);
+        for j in 1..fine {
+            let s = j as f64 / fine as f64;
+            let mut row = *to;
+            row.t = from.t + s * (to.t - from.t);
+            for k in 0..2 {
+                let turn = (to.q[k] * from.q[k].inverse()).scaled_axis();
+                row.q[k] = UnitQuaternion::from_scaled_axis(s * turn) * from.q[k];
+                (row.x[k], row.v[k]) = along_arc(from.x[k], to.x[k], to.v[k], s);
+            }
+            out.push(row);
+        }
+        out.push(*to);
+    }
+    out
+}
+
+/// The point at the fraction `s` of the circular arc from `a` to `b` that ends with the
+/// velocity `v` (constant speed), and its velocity there; a straight line when `v` is zero or
+/// along the chord. A chord b − a of an arc turning by θ about the unit axis e makes the angle
+/// θ/2 with the tangent at either end, and the chord to the fraction s has the length
+/// |b − a|·sin(sθ/2)/sin(θ/2) (circle geometry).
+fn along_arc(a: Vec3, b: Vec3, v: Vec3, s: f64) -> (Vec3, Vec3) {
+    let chord = b - a;
+    let axis = chord.cross(&v);
+    let theta = 2.0 * axis.norm().atan2(chord.dot(&v));
+    match nalgebra::Unit::try_new(axis, 1e-300) {
+        Some(e) if theta.abs() > 1e-12 && chord.dot(&v) > 0.0 => {
+            let turn = |angle: f64| UnitQuaternion::from_axis_angle(&e, angle);
+            let x = a + turn(0.5 * (s - 1.0) * theta)
+                * chord
+                * ((0.5 * s * theta).sin() / (0.5 * theta).sin());
+            (x, turn((s - 1.0) * theta) * v)
+        }
+        _ => (a + s * chord, v),
+    }
+}
+
 /// A motion CSV of `rows` (round-trips bit for bit through [`parse_motion`]).
 pub fn motion_csv(rows: &[MotionRow]) -> String {
     crate::io::csv_table::write(

@@ -91,7 +91,9 @@ pub struct Cycle {
 }
 
 /// Appends `steps` rows translating sphere 2 along the current normal (from sphere 1 to 2) so
-/// that the overlap changes by `-push` (length; positive `push` presses), from the last row.
+/// that the overlap changes by `-push` (length; positive `push` presses), from the last row;
+/// sphere 1 and both orientations are still (zero velocity and spins, whatever the last
+/// row's).
 fn press(rows: &mut Vec<MotionRow>, push: f64, steps: usize, dt: f64) {
     let from = *rows.last().expect("a starting row");
     let n = (from.x[1] - from.x[0]).normalize();
@@ -100,7 +102,8 @@ fn press(rows: &mut Vec<MotionRow>, push: f64, steps: usize, dt: f64) {
         let mut row = from;
         row.t = from.t + k as f64 * dt;
         row.x[1] = from.x[1] + v * (k as f64 * dt);
-        row.v[1] = v;
+        row.v = [Vec3::zeros(), v];
+        row.w = [Vec3::zeros(); 2];
         rows.push(row);
     }
 }

@@ -25,6 +25,7 @@ pub mod mcnamara;
 pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
+pub mod refinement;
 
 use std::path::Path;
 
@@ -101,6 +102,13 @@ pub struct Subject<'a> {
     /// row's expected value (a documented defect), the subject is held to verdem's number
     /// instead, with the same tolerance.
     pub gated_as: Option<Tangential>,
+    /// The convention whose lever arms and slip the rows' expected values use, where they
+    /// differ between conventions: verdem's own law's, or the one a program claims; none for a
+    /// program that claims none (those rows then allow the spread between conventions).
+    pub declared: Option<Tangential>,
+    /// Whether a row it fails at the motion's step is judged again at finer steps
+    /// ([`refinement`]): for a program, whose time discretisation is its own.
+    pub refines: bool,
     pub driver: &'a dyn MotionDriver,
 }
 
@@ -112,6 +120,8 @@ impl Subject<'static> {
             tangential: conv,
             properties: conv.properties(),
             gated_as: None,
+            declared: Some(conv),
+            refines: false,
             driver: &OWN,
         }
     }
@@ -128,6 +138,21 @@ impl<'a> Subject<'a> {
             tangential: claim.unwrap_or(Tangential::Objective),
             properties: claim.unwrap_or(Tangential::Objective).properties(),
             gated_as: claim,
+            declared: claim,
+            refines: true,
+            driver,
+        }
+    }
+
+    /// The same subject driven through `driver`.
+    pub fn driven_by<'b>(&self, driver: &'b dyn MotionDriver) -> Subject<'b> {
+        Subject {
+            label: self.label.clone(),
+            tangential: self.tangential,
+            properties: self.properties,
+            gated_as: self.gated_as,
+            declared: self.declared,
+            refines: self.refines,
             driver,
         }
     }
@@ -185,12 +210,64 @@ pub const MOTION_CASES: [MotionCase; 4] = [
 impl MotionCase {
     /// The rows of `variant` for `subject`, every one gating; a subject gated as a convention
     /// is held to verdem's number of that convention where that convention misses the
-    /// expected value (the quantity then ends in `= verdem NAME`).
+    /// expected value (the quantity then ends in `= verdem NAME`). For a subject that
+    /// [`Subject::refines`], the rows it fails at the motion's step are judged again by
+    /// [`refinement`] (the same motion at dt/2 and dt/4, verdem's numbers too).
     pub fn judge(&self, dir: &Path, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
         let base = Case::load_for_prescribed_motion(&dir.join(self.file))?;
-        let mut rows = (self.rows)(&base, subject, variant)?;
+        let rows = self.judge_at(&base, subject, variant, 1)?;
+        let refine = |r: &Row| r.gate && r.failed() && !is_error(r);
+        if !subject.refines || !rows.iter().any(refine) {
+            return Ok(rows);
+        }
+        let [_, half, quarter] = refinement::FINE;
+        let half = self.judge_at(&base, subject, variant, half)?;
+        let quarter = self.judge_at(&base, subject, variant, quarter)?;
+        let mut judged = Vec::with_capacity(rows.len());
+        // the same quantity, whether or not verdem's number stands in for the expected value
+        // at that step (` = verdem NAME`)
+        let base = |r: &Row| {
+            r.quantity
+                .split(" = verdem ")
+                .next()
+                .unwrap_or("")
+                .to_string()
+        };
+        for ((r, h), q) in rows.into_iter().zip(&half).zip(&quarter) {
+            anyhow::ensure!(
+                base(h) == base(&r) && base(q) == base(&r),
+                "{}: the refined motions gave other rows ({:?}, {:?}) than the motion ({:?})",
+                r.case,
+                h.quantity,
+                q.quantity,
+                r.quantity
+            );
+            judged.push(if refine(&r) {
+                refinement::judged_by_refinement(r, h, q)
+            } else {
+                r
+            });
+        }
+        Ok(judged)
+    }
+
+    /// The rows of `variant` for `subject` with the motion driven at `fine` rows per row.
+    fn judge_at(
+        &self,
+        base: &Case,
+        subject: &Subject,
+        variant: &str,
+        fine: usize,
+    ) -> anyhow::Result<Vec<Row>> {
+        let refined = driver::Refined {
+            inner: subject.driver,
+            fine,
+        };
+        let mut rows = (self.rows)(base, &subject.driven_by(&refined), variant)?;
         if let Some(conv) = subject.gated_as {
-            let own = (self.rows)(&base, &Subject::own(conv), variant)?;
+            let own_refined = driver::Refined { inner: &OWN, fine };
+            let own = Subject::own(conv);
+            let own = (self.rows)(base, &own.driven_by(&own_refined), variant)?;
             for (r, o) in rows.iter_mut().zip(&own) {
                 *r = if o.passed() {
                     Verdict {
@@ -418,6 +495,10 @@ pub fn table(rows: &[Row]) -> String {
             tol,
             result(r)
         ));
+        // a row judged by refinement: its measurements at the finer steps and their order
+        if !r.measured_text.is_empty() {
+            s.push_str(&format!("    {}\n", r.measured_text));
+        }
     }
     s
 }

@@ -42,7 +42,8 @@ pub fn rigid_rotation(rows: &mut Vec<MotionRow>, axis: Vec3, angle: f64, steps: 
 }
 
 /// Appends `steps` rows spinning sphere 2 about `axis` by `angle` in place, then `hold` still
-/// rows, starting from the last row.
+/// rows, starting from the last row; both centres and sphere 1 are still (their velocities
+/// are zero, whatever the last row's).
 pub fn spin_sphere_2(
     rows: &mut Vec<MotionRow>,
     axis: Vec3,
@@ -59,7 +60,11 @@ pub fn spin_sphere_2(
         let mut row = from;
         row.t = from.t + k as f64 * dt;
         row.q[1] = UnitQuaternion::from_axis_angle(&axis, turned) * from.q[1];
-        row.w[1] = if k <= steps { omega } else { Vec3::zeros() };
+        row.v = [Vec3::zeros(); 2];
+        row.w = [
+            Vec3::zeros(),
+            if k <= steps { omega } else { Vec3::zeros() },
+        ];
         rows.push(row);
     }
 }
