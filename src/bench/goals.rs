@@ -2,7 +2,7 @@
 //! of a ratio within a round, met when all of its interval of the median reaches the goal.
 
 use super::cpus::placement;
-use super::rounds::{fastest, paired_ratios, verdem_row, Config, Measured};
+use super::rounds::{fastest, interval, paired_ratios, verdem_row, Config, Measured, CONFIDENCE};
 use super::sweep::{ns_per_particle_step, AtSize};
 use crate::analysis::report::{Case, Detail, Report};
 use crate::analysis::stats::{hinges, median, median_interval};
@@ -42,18 +42,6 @@ const LOCKSTEP_GOAL: f64 = 0.95;
 
 /// The rate on 2 threads asked of verdem, in multiples of a peer's rate on 2 ranks.
 const PEER_GOAL: f64 = 5.0;
-
-/// The confidence of the intervals of the median.
-pub(super) const CONFIDENCE: f64 = 0.95;
-
-/// An interval of the median, in words.
-pub(super) fn interval(found: Option<(f64, f64)>) -> String {
-    let pct = 100.0 * CONFIDENCE;
-    match found {
-        Some((lo, hi)) => format!("{pct:.0} % interval of the median {lo:.3}–{hi:.3}"),
-        None => format!("a {pct:.0} % interval of the median needs 6 rounds or more"),
-    }
-}
 
 /// Whether the median of the distribution the ratios `r` are drawn from reaches `goal`:
 /// [`Outcome::Pass`] when all of its interval of the median does, [`Outcome::Fail`] when none

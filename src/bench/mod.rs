@@ -1,8 +1,8 @@
 //! Timing comparisons on this machine: verdem and the installed peers run the same case from the
 //! same state, alternating (A B A B …) so that drift of a shared machine cancels, with no file
 //! output in the timed region ([`rounds`]); the same at several system sizes ([`sweep`]); the
-//! tables with the goals they judge ([`goals`]), where the two CPUs sat ([`cpus`]), the cost
-//! plot ([`cost`]) and what the machine is ([`machine`]).
+//! tables with the goals they judge ([`goals`]), the core-to-core probe ([`probe`]), where the
+//! two CPUs sat ([`cpus`]), the cost plot ([`cost`]) and what the machine is ([`machine`]).
 
 mod cost;
 mod cpus;
@@ -10,6 +10,7 @@ mod cpus;
 mod fixtures;
 mod goals;
 mod machine;
+mod probe;
 mod rounds;
 mod sweep;
 

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use super::cpus::{round_trip_ns, PROBE_TRIPS};
+use super::probe::{round_trip_ns, PROBE_TRIPS};
 use crate::analysis::stats::median;
 use crate::case::Case;
 use crate::peers::Peer;
@@ -283,6 +283,18 @@ fn advance_in_chunks(
 }
 
 /// The rate of `b` over that of `a` in each round (paired: the runs of one round are seconds
+/// The confidence of the intervals of the median.
+pub(super) const CONFIDENCE: f64 = 0.95;
+
+/// An interval of the median, in words.
+pub(super) fn interval(found: Option<(f64, f64)>) -> String {
+    let pct = 100.0 * CONFIDENCE;
+    match found {
+        Some((lo, hi)) => format!("{pct:.0} % interval of the median {lo:.3}–{hi:.3}"),
+        None => format!("a {pct:.0} % interval of the median needs 6 rounds or more"),
+    }
+}
+
 /// apart, so a drift of the machine cancels).
 pub(super) fn paired_ratios(a: &Measured, b: &Measured) -> Vec<f64> {
     a.rates.iter().zip(&b.rates).map(|(x, y)| y / x).collect()

@@ -3,7 +3,7 @@
 //! units.
 
 use super::lammps_family::{boundary, neighbor, Dialect, GROUPS};
-use super::motion::MotionPeer;
+use super::libraries::MotionPeer;
 use crate::case::Case;
 use crate::contact::Tangential;
 use crate::state::Snapshot;

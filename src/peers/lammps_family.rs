@@ -19,7 +19,7 @@ use anyhow::{bail, ensure, Context};
 pub mod dump;
 
 use super::inrun::WALLS_FILE;
-use super::motion::MotionPeer;
+use super::libraries::MotionPeer;
 use super::{
     placed_contacts, wall_speeds, Frame, Installed, Lacks, Launch, Naming, Peer, Program, Run,
     Save, MPIRUN,

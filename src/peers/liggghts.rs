@@ -2,7 +2,7 @@
 //! tangential history absolute_damping on`, in SI units; coefficients per pair of atom types.
 
 use super::lammps_family::{boundary, neighbor, Dialect, DUMP_COLUMNS, GROUPS};
-use super::motion::MotionPeer;
+use super::libraries::MotionPeer;
 use crate::case::Case;
 use crate::contact::Tangential;
 use crate::state::Snapshot;

@@ -20,11 +20,12 @@ pub mod inrun;
 pub mod kratos;
 pub mod lammps;
 pub mod lammps_family;
+pub mod libraries;
 pub mod liggghts;
 pub mod motion;
 pub mod yade;
 
-use self::motion::MotionPeer;
+use self::libraries::MotionPeer;
 use crate::case::{Case, Scene};
 use crate::child::{self, OnParentDeath};
 use crate::contact::Tangential;

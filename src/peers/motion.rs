@@ -52,23 +52,11 @@ use crate::verify::driver::MotionDriver;
 use crate::verify::kinematics::{pair_of, ForceRow, Increment, MotionRow};
 use crate::Vec3;
 
-/// A peer whose contact law can be driven through a prescribed motion in process.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MotionPeer {
-    Lammps,
-    /// LAMMPS with the classic `pair_style gran/hooke/history` (not a peer of the cross-runs).
-    LammpsHookeHistory,
-    Liggghts,
-}
+pub use super::libraries::MotionPeer;
 
+/// What each library is and how it is set up: its name, convention and input lines come from
+/// its peer's dialect.
 impl MotionPeer {
-    /// Every such peer.
-    pub const ALL: [MotionPeer; 3] = [
-        MotionPeer::Lammps,
-        MotionPeer::LammpsHookeHistory,
-        MotionPeer::Liggghts,
-    ];
-
     /// Its name on the command line (that of the peer in [`super::all`]).
     pub fn name(self) -> &'static str {
         match self {
