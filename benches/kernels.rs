@@ -98,7 +98,7 @@ fn step(c: &mut Criterion) {
 fn barrier(c: &mut Criterion) {
     c.bench_function("barrier, 2 threads (one round)", |b| {
         b.iter_custom(|rounds| {
-            let barrier = verdem::team::SpinBarrier::new(2);
+            let barrier = verdem::step::team::SpinBarrier::new(2);
             std::thread::scope(|s| {
                 s.spawn(|| (0..rounds).for_each(|_| barrier.wait()));
                 // both threads are in the loop before the clock starts

@@ -13,7 +13,6 @@ pub mod contact;
 pub mod ensemble;
 pub mod file_name;
 pub mod io;
-pub mod neighbor;
 pub mod peers;
 pub mod python;
 pub mod run;
@@ -21,7 +20,6 @@ pub mod scene;
 pub mod stability;
 pub mod state;
 pub mod step;
-pub mod team;
 pub mod tradeoff;
 pub mod verify;
 

@@ -337,8 +337,8 @@ fn a_law_that_gives_back_more_than_it_received_is_stopped() {
     use verdem::contact::normal::LinearSpringDashpot;
     use verdem::contact::tangential::Frictionless;
     use verdem::contact::Composed;
-    use verdem::neighbor::NeighborBuilder;
     use verdem::state::{Domain, Motion, Particles};
+    use verdem::step::neighbor::NeighborBuilder;
     use verdem::step::{Core, Engine, Simulation};
     use verdem::Vec3;
 
@@ -410,7 +410,7 @@ fn a_slightly_creative_law_is_found_in_a_large_gas() {
     use verdem::contact::normal::LinearSpringDashpot;
     use verdem::contact::tangential::Frictionless;
     use verdem::contact::Composed;
-    use verdem::neighbor::NeighborBuilder;
+    use verdem::step::neighbor::NeighborBuilder;
     use verdem::step::{Core, Engine, Simulation};
 
     let case =

@@ -3,8 +3,8 @@
 //! spring-dashpot that also counts its contact's age in steps (history: ξ and the age).
 
 use verdem::contact::{ContactLaw, PairKinematics};
-use verdem::neighbor::NeighborBuilder;
 use verdem::state::{Domain, History, Motion, PairForce, Particles};
+use verdem::step::neighbor::NeighborBuilder;
 use verdem::step::{Core, Engine, Simulation};
 use verdem::Vec3;
 

@@ -10,9 +10,9 @@ use verdem::case::Case;
 use verdem::contact::{
     ContactLaw, Dissipated, LinearSpringDashpot, MercuryLaw, MercurySlidingFriction, PairKinematics,
 };
-use verdem::neighbor::NeighborBuilder;
 use verdem::state::PairForce;
 use verdem::step::engine::Overrides;
+use verdem::step::neighbor::NeighborBuilder;
 use verdem::step::{Core, Engine, LedgerRow, Simulation};
 use verdem::Vec3;
 

@@ -4,8 +4,8 @@
 
 use verdem::case::Search;
 use verdem::contact::{Composed, LinearSpringDashpot, MercuryLaw, MercurySlidingFriction};
-use verdem::neighbor::NeighborBuilder;
 use verdem::state::{Domain, Motion, Particles};
+use verdem::step::neighbor::NeighborBuilder;
 use verdem::step::{Core, Engine, LedgerRow, Simulation};
 use verdem::Vec3;
 

@@ -103,7 +103,7 @@ fn runs_in_lockstep_meet_once_a_step_and_keep_the_bits() {
         engine(&case, Some(&state), Overrides::default()).as_mut(),
         700,
     );
-    let barrier = std::sync::Arc::new(verdem::team::SpinBarrier::new(2));
+    let barrier = std::sync::Arc::new(verdem::step::team::SpinBarrier::new(2));
     let hashes: Vec<String> = std::thread::scope(|s| {
         let runs: Vec<_> = (0..2)
             .map(|_| {
@@ -173,7 +173,7 @@ fn reordered_force_summation_changes_the_hash() {
 fn a_team_larger_than_its_cpus_is_warned_about_and_keeps_the_bits() {
     let state = data("states/mercury_t143.85.data");
     let case = root().join("cases/shear_flow_quick.toml");
-    let cpu = verdem::team::allowed_cpus()
+    let cpu = verdem::step::team::allowed_cpus()
         .first()
         .expect("sched_getaffinity")
         .to_string();

@@ -155,7 +155,7 @@ fn a_system_of_several_chunks_keeps_its_bits_on_one_two_and_three_threads() {
     };
     let (reference, rebuilds, particles) = run(1);
     // 69600 particles: three chunks on one thread
-    assert!(particles > 2 * verdem::neighbor::rebuild::CHUNK_PARTICLES);
+    assert!(particles > 2 * verdem::step::neighbor::rebuild::CHUNK_PARTICLES);
     assert!(rebuilds >= 2, "{rebuilds} rebuilds");
     assert_eq!(run(2).0, reference, "2 threads");
     assert_eq!(run(3).0, reference, "3 threads");

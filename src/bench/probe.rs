@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use crate::team::{allowed_cpus, Bound};
+use crate::step::team::{allowed_cpus, Bound};
 
 /// The counter the probe's two threads hand to each other, on a cache line of its own: no other
 /// datum travels with it.

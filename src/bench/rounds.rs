@@ -15,8 +15,8 @@ use crate::analysis::stats::median;
 use crate::case::Case;
 use crate::peers::Peer;
 use crate::step::engine::{self, Overrides};
+use crate::step::team::{Bound, SpinBarrier};
 use crate::step::StageTimes;
-use crate::team::{Bound, SpinBarrier};
 
 /// One configuration: a code and its number of threads or MPI ranks.
 #[derive(Clone, Debug, PartialEq)]

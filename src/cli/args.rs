@@ -102,7 +102,7 @@ impl Common {
             cell: self.cell,
         };
         let engine = engine::build(&case, scene, &o)?;
-        if let Some(warning) = verdem::team::oversubscribed(engine.params().threads) {
+        if let Some(warning) = verdem::step::team::oversubscribed(engine.params().threads) {
             eprintln!("warning: {warning}");
         }
         Ok((case, engine))

@@ -104,7 +104,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
     for warning in a
         .threads
         .iter()
-        .filter_map(|&t| verdem::team::oversubscribed(t))
+        .filter_map(|&t| verdem::step::team::oversubscribed(t))
     {
         eprintln!("warning: {warning}");
     }

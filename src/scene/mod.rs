@@ -11,10 +11,10 @@ use rand::{Rng, SeedableRng};
 
 use crate::case::{Case, Scene as SceneSpec, Search};
 use crate::io::{mercury, official};
-use crate::neighbor::{NeighborBuilder, PairList};
 use crate::state::Domain;
 use crate::state::{memory, Motion, Particles};
 pub use crate::step::engine::Scene;
+use crate::step::neighbor::{NeighborBuilder, PairList};
 use crate::Vec3;
 
 /// The box of a case.

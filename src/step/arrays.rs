@@ -15,9 +15,9 @@
 
 use std::sync::atomic::AtomicBool;
 
-use crate::neighbor::rebuild::{ListState, CLASSES};
 use crate::state::{Motion, PairForce, Tally};
-use crate::team::SharedSlice;
+use crate::step::neighbor::rebuild::{ListState, CLASSES};
+use crate::step::team::SharedSlice;
 use crate::Vec3;
 
 /// Views of every array a step's threads share.

@@ -8,10 +8,10 @@ use std::sync::Arc;
 use super::counters::StageTimes;
 use super::guard::Failure;
 use crate::case::Guard;
-use crate::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
-use crate::neighbor::NeighborBuilder;
 use crate::state::{Contact, Domain, History, PairForce, Particles, SampledContact, Snapshot};
-use crate::team::{Crew, Shared};
+use crate::step::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
+use crate::step::neighbor::NeighborBuilder;
+use crate::step::team::{Crew, Shared};
 use crate::Vec3;
 
 /// The dynamic state. Particle arrays are in memory order (re-ordered by cell at every pair-list

@@ -65,7 +65,7 @@ pub(super) fn measure<L: ContactLaw>(
     pt: &Particles,
     domain: &Domain,
     gravity: Option<Vec3>,
-    pairs: &crate::neighbor::rebuild::Pairs<L::History>,
+    pairs: &crate::step::neighbor::rebuild::Pairs<L::History>,
 ) -> Energy {
     let walled_g = gravity.map(|g| g - periodic_part(g, domain));
     let (mut kinetic, mut potential, mut stored) = (0i128, 0i128, 0i128);
@@ -290,7 +290,7 @@ pub(super) fn read<L: ContactLaw>(
     pt: &Particles,
     domain: &Domain,
     gravity: Option<Vec3>,
-    pairs: &crate::neighbor::rebuild::Pairs<L::History>,
+    pairs: &crate::step::neighbor::rebuild::Pairs<L::History>,
     (step, dt, flows): (u64, f64, Flows),
 ) -> Reading {
     let walled_g = gravity.map(|g| g - periodic_part(g, domain));

@@ -11,8 +11,8 @@ use crate::contact::{
     Composed, ContactLaw, Frictionless, Normal, NormalModel, NormalVisitor, Parameters, Tangential,
     TangentialModel, TangentialVisitor,
 };
-use crate::neighbor::NeighborBuilder;
 use crate::state::{Domain, History, Particles, SampledContact, Snapshot};
+use crate::step::neighbor::NeighborBuilder;
 use crate::Vec3;
 
 /// The law-independent face of a simulation, for the run loop and the tools.

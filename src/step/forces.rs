@@ -7,9 +7,9 @@ use super::arrays::Arrays;
 use super::energy::{fixed, Flows};
 use super::guard::Breach;
 use crate::contact::{ContactLaw, Dissipated, PairInput};
-use crate::neighbor::rebuild::{Pairs, CLASSES};
 use crate::state::{Domain, Motion, PairForce, Tally};
-use crate::team::SharedSlice;
+use crate::step::neighbor::rebuild::{Pairs, CLASSES};
+use crate::step::team::SharedSlice;
 use crate::Vec3;
 
 /// What the pair pass reads besides the slots: the law, the box, the time step (time) and the
@@ -79,7 +79,7 @@ pub(super) struct PairSlots<'a, H> {
 
 /// Pair pass over pair chunk `c`: first its live ends are grown to every pair whose gap at the
 /// build the particles can have `closed` since (length, by class of speed: see
-/// [`crate::neighbor::rebuild::gap_closed`]), then the live prefix of each class is visited. A
+/// [`crate::step::neighbor::rebuild::gap_closed`]), then the live prefix of each class is visited. A
 /// pair beyond reach cannot touch yet; its slot stays inactive, exactly as a full pass would
 /// leave it. The first `CLASSES / 2` classes hold interior pairs, whose direct separation is
 /// their minimum image. One call per chunk rather than per class: fewer loop starts. Returns

@@ -1,4 +1,5 @@
-//! The time step, top to bottom, and the state it advances.
+//! The time step, top to bottom, and the state it advances; what it runs on: the pair list
+//! ([`neighbor`]) and the thread team ([`team`]).
 //!
 //! One step n → n+1 (MercuryDPM's order, `docs/benchmark.md` "How MercuryDPM computes it"):
 //! 1. kick–drift of every free particle: v += (F/m + g)·dt/2, x += v·dt, ω += T/I·dt/2;
@@ -34,6 +35,8 @@ pub mod engine;
 mod forces;
 pub mod guard;
 mod integrate;
+pub mod neighbor;
+pub mod team;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -46,9 +49,9 @@ use self::forces::{book_dropped, contact_breach, pair_chunk, pair_force, PairVie
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
 use crate::contact::ContactLaw;
-use crate::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
 use crate::state::{Domain, SampledContact};
-use crate::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
+use crate::step::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
+use crate::step::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
 use counters::Laps;
 
@@ -686,9 +689,9 @@ mod tests {
     use super::{Core, Simulation};
     use crate::case::Case;
     use crate::contact::ContactLaw;
-    use crate::neighbor::NeighborBuilder;
     use crate::step::engine::Scene;
     use crate::step::engine::{self, LawVisitor};
+    use crate::step::neighbor::NeighborBuilder;
     use std::path::Path;
 
     /// Runs `steps` steps of the scene on one thread under the case's law, then checks the

@@ -16,32 +16,25 @@
 use super::objectivity::{spin_sphere_2, tangent_axis};
 use super::{row, row_abs, Row, Subject};
 use crate::case::Case;
-use crate::contact::Tangential;
+use crate::contact::{Arms, Tangential};
 use crate::verify::kinematics::{pair_of, ForceRow, MotionRow};
 use crate::Vec3;
 
 /// The arms a convention uses when sphere 2 spins about a tangent axis at a fixed normal, as
 /// multiples of R2 − δ/2 (the arm to the contact point in the middle of the overlap): its
-/// slip arm (how far the contact point slides per radian) and its torque arm. Lever arms to
-/// the contact point, R − δ/2, in the slip of MercuryDPM, LIGGGHTS and Yade's ViscEl law; full
-/// radii in the slip of LAMMPS, Cundall, Yade's and the objective law (`contact::tangential`:
-/// `HalfOverlapSlip`, `FullRadiusSlip`, the objective slips). Full radii in the torques of
-/// LAMMPS `gran/hooke/history` and Cundall, R − δ/2 in the others.
+/// slip arm (how far the contact point slides per radian) and its torque arm, as the model's
+/// parts declare them ([`Tangential::geometry`]): 1 for arms to the contact point, R − δ/2
+/// (the slip of MercuryDPM, LIGGGHTS and Yade's ViscEl law; the torques of all but two),
+/// R2/(R2 − δ/2) for full radii (the slip of LAMMPS, Cundall, Yade's and the objective law; the
+/// torques of LAMMPS `gran/hooke/history` and Cundall).
 pub fn arms(conv: Tangential, radius: f64, delta: f64) -> (f64, f64) {
     let full = radius / (radius - 0.5 * delta);
-    let slip = match conv {
-        Tangential::Mercury | Tangential::Liggghts | Tangential::YadeViscEl => 1.0,
-        Tangential::LammpsHookeHistory
-        | Tangential::LammpsGranular
-        | Tangential::Yade
-        | Tangential::Cundall
-        | Tangential::Objective => full,
+    let factor = |arms| match arms {
+        Arms::HalfOverlap => 1.0,
+        Arms::FullRadius => full,
     };
-    let torque = match conv {
-        Tangential::LammpsHookeHistory | Tangential::Cundall => full,
-        _ => 1.0,
-    };
-    (slip, torque)
+    let g = conv.geometry();
+    (factor(g.slip), factor(g.torque))
 }
 
 /// The histories, by their names in the table.

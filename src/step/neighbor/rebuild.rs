@@ -12,7 +12,7 @@ use std::sync::atomic::AtomicBool;
 
 use super::{NeighborBuilder, PairList};
 use crate::state::{Domain, History, Motion, PairForce, Particles, Tally};
-use crate::team::{balanced_ranges, Crew, Shared, SharedSlice};
+use crate::step::team::{balanced_ranges, Crew, Shared, SharedSlice};
 use crate::Vec3;
 
 /// Gap bins of the pair list: one of overlapping pairs, then sixteen of a sixteenth of the skin
