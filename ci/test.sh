@@ -47,7 +47,11 @@ echo "== formatting and lints"
 cargo fmt --check
 cargo clippy --profile ci --all-targets -- -D warnings
 
-echo "== tests (profile ci: optimised, as the solver runs in them; Cargo.toml says why not release)"
+echo "== the binary, then the tests (profile ci: optimised, as the solver runs in them; Cargo.toml says why not release)"
+# Built alone first, so that its dependencies are compiled with the features a plain build
+# gives them: the scratch builds of tests/recipe.rs and tests/recipe_peer.rs copy them and
+# compile verdem only.
+cargo build --profile ci --bin verdem
 cargo test --profile ci --all-targets 2>&1 | tee /tmp/verdem-test.log
 
 echo "== the release build, which users run, gives the tests' build's bits"
