@@ -103,7 +103,7 @@ pub fn judged_by_refinement(at: Row, half: &Row, quarter: &Row) -> Row {
         ),
     };
     let text = format!(
-        "{:.6e} at dt, {:.6e} at dt/2, {:.6e} at dt/4; observed order {order}; {verdict}",
+        "{:.6e} at dt; {:.6e} at dt/2; {:.6e} at dt/4; observed order {order}; {verdict}",
         at.measured, half.measured, quarter.measured
     );
     Row {
