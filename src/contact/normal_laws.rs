@@ -8,8 +8,6 @@
 //! ([`NormalModel::SPLITS_DISSIPATION`]); `[contact] clip_normal` clips any of them
 //! ([`super::normal::Clipped`]).
 
-use serde::Deserialize;
-
 use super::{LinearSpringDashpot, NormalModel, Parameters};
 
 /// Something done with a normal model, whichever concrete type the case's law names.
@@ -31,11 +29,10 @@ macro_rules! normal_laws {
         $($(pub mod $file;)?)*
 
         /// A normal law (spring and damping), named in a case's `[contact] normal`.
-        #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
         pub enum Normal {
             $(
                 #[doc = $description]
-                #[serde(rename = $name)]
                 $variant,
             )*
         }

@@ -9,8 +9,6 @@
 //! ([`Geometry`]: whether its torques conserve angular momentum, what the verification's
 //! theory predicts for it) is read from the model's parts.
 
-use serde::Deserialize;
-
 use super::tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox, YadeViscEl,
@@ -91,11 +89,10 @@ macro_rules! conventions {
             $description:literal;
     )*) => {
         /// A tangential contact convention, named in a case's `[contact] tangential`.
-        #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
         pub enum Tangential {
             $(
                 #[doc = $description]
-                #[serde(rename = $name)]
                 $variant,
             )*
         }
