@@ -4,7 +4,7 @@
 //! contact loss.
 //!
 //! Sphere 1 stays still; sphere 2 spins in place about a tangent axis t (the normal n stays
-//! put, so no frame update acts), dashpots off. Spinning sphere 2 by φ slides its contact
+//! put, so no frame update acts), dashpots off but in the history that measures them. Spinning sphere 2 by φ slides its contact
 //! point by l₂φ, l₂ = R₂ − δ/2 the arm to the contact point in the middle of the overlap, and
 //! the spring pushes sphere 2 along t × n with kt·l₂·φ, up to the Coulomb limit mu·fn. Both
 //! torques about the spheres' centres oppose the spin: −l·|Ft| along t. Conventions that take
@@ -12,6 +12,12 @@
 //! subject whose convention is known ([`Subject::declared`]) the rows that depend on the arm
 //! expect that convention's own arms ([`arms`]) to round-off, so that a stiffness off by 1e-4
 //! fails; for a program that names none they allow the spread δ/R between conventions.
+//!
+//! The dashpots' history presses sphere 2 onto sphere 1 at a constant speed u and holds it,
+//! then spins it at a constant rate ω and holds it: the force while moving less the force held
+//! at the same overlap and spring is the dashpot's alone, γn·u along n and γt times the slip
+//! along t × n, below the cap for every convention (fn = kn·δ − γn·vn, Ft = −kt·ξ − γt·slip
+//! while sticking, `src/contact/normal.rs`, `tangential/cap.rs`).
 
 use super::objectivity::{spin_sphere_2, tangent_axis};
 use super::{row, row_abs, Row, Subject};
@@ -38,7 +44,7 @@ pub fn arms(conv: Tangential, radius: f64, delta: f64) -> (f64, f64) {
 }
 
 /// The histories, by their names in the table.
-pub const HISTORIES: [&str; 3] = ["load-unload", "coulomb limit", "contact loss"];
+pub const HISTORIES: [&str; 4] = ["load-unload", "coulomb limit", "contact loss", "dashpots"];
 
 /// The name of the history named `label` of `subject`'s contact.
 pub fn case_name(subject: &str, label: &str) -> String {
@@ -70,8 +76,10 @@ fn ft2(f: &ForceRow, n: Vec3) -> f64 {
 /// The rows of the history named `label` (one of [`HISTORIES`]) of `subject`'s contact.
 pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Result<Vec<Row>> {
     let mut case = subject.case(base);
-    case.contact.gamman = 0.0;
-    case.contact.gammat = 0.0;
+    if label != "dashpots" {
+        case.contact.gamman = 0.0;
+        case.contact.gammat = 0.0;
+    }
     let (x, radius) = pair_of(&case)?;
     let dt = case.dt();
     let r = x[1] - x[0];
@@ -186,6 +194,51 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                     "|Ft| / (mu fn) back by mu fn/kt",
                     slip_arm - 1.0,
                     ft2(&f[f.len() - 1], n) / limit,
+                    arm_tol,
+                ),
+            ]
+        }
+        "dashpots" => {
+            anyhow::ensure!(
+                c.gamman > 0.0 && c.gammat > 0.0,
+                "{}: contact: the dashpots' history needs gamman > 0 and gammat > 0",
+                case.path.display()
+            );
+            // pressed by a tenth of the overlap a row for two rows, then held: the overlap
+            // and the spring of the last press row, at rest
+            let press = 0.1 * delta;
+            let u = press / dt;
+            jump_sphere_2(&mut rows, -press * n, 0, dt);
+            jump_sphere_2(&mut rows, -press * n, 10, dt);
+            let (pressing, pressed) = (2, rows.len() - 1);
+            // spun for two rows at the slip rate that loads spring + dashpot to half the
+            // sliding limit of the pressed overlap, then held; the arms are those of the
+            // pressed overlap
+            let pressed_delta = delta + 2.0 * press;
+            let arm = radius[1] - 0.5 * pressed_delta;
+            let slip_arm = match subject.declared {
+                Some(conv) => arms(conv, radius[1], pressed_delta).0,
+                None => 1.0,
+            };
+            let sliding = c.mu * c.kn * pressed_delta;
+            let omega = 0.5 * sliding / ((2.0 * c.kt * dt + c.gammat) * arm);
+            spin_sphere_2(&mut rows, t, omega * 2.0 * dt, 2, 10, dt);
+            let (spinning, spun) = (pressed + 2, rows.len() - 1);
+            let f = drive(&rows)?;
+            let along_t = |k: usize| f[k].f[1].dot(&along);
+            vec![
+                row(
+                    &name,
+                    "(fn pressing - fn held) / (gamman u)",
+                    1.0,
+                    (f[pressing].fn_signed - f[pressed].fn_signed) / (c.gamman * u),
+                    1e-9,
+                ),
+                row(
+                    &name,
+                    "(Ft spinning - Ft held) / (gammat l2 omega)",
+                    slip_arm,
+                    (along_t(spinning) - along_t(spun)) / (c.gammat * arm * omega),
                     arm_tol,
                 ),
             ]
