@@ -303,9 +303,10 @@ fn the_kinematics_command_checks_the_law_not_the_time_step_and_warns_about_coars
     assert!(ok, "{stderr}");
     let warning = format!(
         "warning: {}:3: rows up to Δt = {coarse:.4e} apart while the spheres touch, coarse for \
-         this law's collision time tc = {tc:.4e} (tc/Δt = {:.3}, below 10): the forces are the \
-         law's at these rows, not an integration's",
+         the collision time of the law of {}, tc = {tc:.4e} (tc/Δt = {:.3}, below 10): the \
+         forces are the law's at these rows, not an integration's",
         motion.display(),
+        stiff.display(),
         tc / coarse
     );
     assert!(tc / coarse < 10.0);

@@ -53,11 +53,12 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         if kinematics::coarse(dt, tc) {
             eprintln!(
                 "warning: {file}:{}: rows up to Δt = {dt:.4e} apart while the spheres touch, \
-                 coarse for this law's collision time tc = {tc:.4e} (tc/Δt = {:.3}, below \
-                 {COARSE_STEPS_PER_COLLISION}): the forces are the law's at these rows, not an \
-                 integration's, and the collision's course between them is not seen; rows at \
-                 most tc/{COARSE_STEPS_PER_COLLISION} = {:.4e} apart resolve it",
+                 coarse for the collision time of the law of {}, tc = {tc:.4e} (tc/Δt = {:.3}, \
+                 below {COARSE_STEPS_PER_COLLISION}): the forces are the law's at these rows, \
+                 not an integration's, and the collision's course between them is not seen; \
+                 rows at most tc/{COARSE_STEPS_PER_COLLISION} = {:.4e} apart resolve it",
                 lines[k],
+                a.case.display(),
                 tc / dt,
                 tc / COARSE_STEPS_PER_COLLISION
             );
