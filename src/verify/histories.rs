@@ -1,17 +1,18 @@
 //! Histories of the tangential spring of one contact at constant overlap, per tangential
-//! convention (or for an external program), through a [`super::driver::MotionDriver`]: loaded and unloaded
-//! below the sliding limit, taken to the Coulomb limit and back, and carried through a
-//! contact loss.
+//! convention (or for an external program), through a [`super::driver::MotionDriver`]: loaded
+//! and unloaded below the sliding limit, taken to the Coulomb limit and back, carried through
+//! a contact loss, and its dashpots' parts at a prescribed press and spin.
 //!
 //! Sphere 1 stays still; sphere 2 spins in place about a tangent axis t (the normal n stays
-//! put, so no frame update acts), dashpots off but in the history that measures them. Spinning sphere 2 by φ slides its contact
-//! point by l₂φ, l₂ = R₂ − δ/2 the arm to the contact point in the middle of the overlap, and
-//! the spring pushes sphere 2 along t × n with kt·l₂·φ, up to the Coulomb limit mu·fn. Both
-//! torques about the spheres' centres oppose the spin: −l·|Ft| along t. Conventions that take
-//! the full radius as slip arm or lever arm differ from these by δ/(2R) relative: for a
-//! subject whose convention is known ([`Subject::declared`]) the rows that depend on the arm
-//! expect that convention's own arms ([`arms`]) to round-off, so that a stiffness off by 1e-4
-//! fails; for a program that names none they allow the spread δ/R between conventions.
+//! put, so no frame update acts), dashpots off but in the history that measures them.
+//! Spinning sphere 2 by φ slides its contact point by l₂φ, l₂ = R₂ − δ/2 the arm to the
+//! contact point in the middle of the overlap, and the spring pushes sphere 2 along t × n
+//! with kt·l₂·φ, up to the Coulomb limit mu·fn. Both torques about the spheres' centres
+//! oppose the spin: −l·|Ft| along t. Conventions that take the full radius as slip arm or
+//! lever arm differ from these by δ/(2R) relative: for a subject whose convention is known
+//! ([`Subject::declared`]) the rows that depend on the arm expect that convention's own arms
+//! ([`arms`]) to round-off, so that a stiffness or a dashpot off by 1e-4 fails; for a program
+//! that names none they allow the spread δ/R between conventions.
 //!
 //! The dashpots' history presses sphere 2 onto sphere 1 at a constant speed u and holds it,
 //! then spins it at a constant rate ω and holds it: the force while moving less the force held
@@ -226,6 +227,8 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
             let (spinning, spun) = (pressed + 2, rows.len() - 1);
             let f = drive(&rows)?;
             let along_t = |k: usize| f[k].f[1].dot(&along);
+            // fn = kn·δ − γn·vn (MercuryDPM's LinearViscoelasticNormalSpecies) and, below the
+            // cap, Ft = −kt·ξ − γt·slip (every convention's cap, src/contact/tangential/cap.rs)
             vec![
                 row(
                     &name,
