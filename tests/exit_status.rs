@@ -274,7 +274,7 @@ fn a_run_stopped_by_a_signal_exits_with_130_after_its_checkpoint() {
     let text = std::fs::read_to_string(&case).unwrap();
     std::fs::write(&case, text.replace("5.0, 0.0, 0.0]", "0.0, 0.0, 0.0]")).unwrap();
     let out = dir.path().join("out");
-    let mut child = verdem(&["run", &case, "--quiet", "--out", out.to_str().unwrap()])
+    let child = verdem(&["run", &case, "--quiet", "--out", out.to_str().unwrap()])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
