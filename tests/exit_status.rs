@@ -329,3 +329,80 @@ fn a_command_without_a_graceful_stop_ends_by_the_signal() {
     assert_eq!(status.code(), None, "{status}");
     assert_eq!(status.signal(), Some(libc::SIGTERM), "{status}");
 }
+
+/// The library's errors are typed: a program embedding verdem tells them apart by matching, not
+/// by reading their text.
+#[test]
+fn the_library_s_errors_are_matched_by_their_types() {
+    use verdem::io::checkpoint::{self, CheckpointError};
+    use verdem::run::RunError;
+    use verdem::scene::SceneError;
+
+    let dir = tempfile::tempdir().unwrap();
+    let case = common::quick_case();
+    let mut e = common::engine(&case, None, Default::default());
+    let tag = checkpoint::tag(&case);
+    let ck = dir.path().join("q.checkpoint");
+    checkpoint::write(&ck, &e.snapshot(), e.params().dt, &tag).unwrap();
+    let bytes = std::fs::read(&ck).unwrap();
+    let mut flipped = bytes.clone();
+    flipped[100] ^= 1;
+    let restored = |b: &[u8], e: &mut dyn verdem::step::Engine| {
+        checkpoint::restore("c.ck", b, e, &tag).unwrap_err()
+    };
+    assert!(matches!(
+        restored(&flipped, e.as_mut()),
+        CheckpointError::Corrupt { len, .. } if len == bytes.len() - 32
+    ));
+    assert!(matches!(
+        restored(b"VERDEMC1 and the rest", e.as_mut()),
+        CheckpointError::Version { version: 1, .. }
+    ));
+    assert!(matches!(
+        restored(b"GARBAGE!", e.as_mut()),
+        CheckpointError::NotCheckpoint { .. }
+    ));
+    let other = checkpoint::read(&ck, e.as_mut(), "case=\"other\"").unwrap_err();
+    assert!(
+        matches!(&other, CheckpointError::OtherRun { differs, .. } if differs.len() == 2),
+        "{other}"
+    );
+    let missing = checkpoint::read(&dir.path().join("none"), e.as_mut(), &tag).unwrap_err();
+    assert!(matches!(missing, CheckpointError::Read { .. }), "{missing}");
+
+    let two = dir.path().join("two.data");
+    std::fs::write(
+        &two,
+        "2 0 0 0 0 20 10.3923048454133 22\n1 1 1 0 0 0 0.5 0 0 0 0 0 0 0\n\
+         2 2 2 0 0 0 0.5 0 0 0 0 0 0 0\n",
+    )
+    .unwrap();
+    let Err(count) = verdem::scene::build(&case, Some(&two)) else {
+        panic!("a scene of the two spheres was built");
+    };
+    assert!(
+        matches!(
+            count,
+            SceneError::Count {
+                found: 2,
+                wall: 480,
+                free: 3000,
+                ..
+            }
+        ),
+        "{count}"
+    );
+    let Err(unread) = verdem::scene::build(&case, Some(&dir.path().join("none"))) else {
+        panic!("a scene of no file was built");
+    };
+    assert!(matches!(unread, SceneError::Format(_)), "{unread}");
+
+    let out = dir.path().join("out");
+    let lock = verdem::io::lock::lock_folder(&out).unwrap();
+    std::fs::write(out.join("q.summary.toml"), "").unwrap();
+    let occupied = verdem::run::claim_output_folder(&out, "q", false, "--force", &lock);
+    assert!(
+        matches!(&occupied, Err(RunError::Occupied { found, .. }) if found.len() == 1),
+        "{occupied:?}"
+    );
+}
