@@ -70,11 +70,27 @@ enum Command {
 
 fn main() {
     // first, before any thread starts (cli::signals)
-    if let Err(e) = cli::signals::install() {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+    let outcome = cli::signals::install()
+        .and_then(|()| Ok(Cli::try_parse()?))
+        .and_then(|cli| dispatch(cli.command));
+    if let Err(e) = &outcome {
+        match e.downcast_ref::<clap::Error>() {
+            // clap's own text: the usage error on stderr, or the help or version on stdout
+            Some(usage) => {
+                let _ = usage.print();
+            }
+            None => eprintln!("error: {e:#}"),
+        }
     }
-    let outcome = match Cli::parse().command {
+    match exit_status(&outcome) {
+        0 => {}
+        status => std::process::exit(status),
+    }
+}
+
+/// Runs the command `command`.
+fn dispatch(command: Command) -> anyhow::Result<Finished> {
+    match command {
         Command::Run(a) => cli::run::exec(a),
         Command::Cg(a) => cli::cg::exec(a),
         Command::Bench(a) => cli::bench::exec(a),
@@ -89,39 +105,33 @@ fn main() {
         Command::Tile(a) => cli::tile::exec(a),
         Command::Vtk(a) => cli::vtk::exec(a),
         Command::Extremes(a) => cli::extremes::exec(a),
-    };
-    if let Err(e) = &outcome {
-        eprintln!("error: {e:#}");
-    }
-    match exit_status(&outcome) {
-        0 => {}
-        status => std::process::exit(status),
     }
 }
 
-/// The exit status of a command that ended with `outcome`: 0 when done, [`EXIT_INTERRUPTED`]
-/// for a run a signal stopped, 1 when checks failed or on an error, [`EXIT_GUARD`] when the
-/// error is the run guard's, by its type however the layers above wrapped it
-/// ([`guard_stopped`]). A usage error exits with 2 before a command starts (clap's
-/// `Cli::parse`).
+/// The exit status of a command that ended with `outcome` (docs/cli.md, "Exit statuses"), the
+/// one place it is decided: 0 when done, [`EXIT_INTERRUPTED`] for a run a signal stopped, 1
+/// when checks failed; for an error, by its type however the layers above wrapped it: clap's
+/// (a command line that does not parse or an option out of range) its own status, 2 (0 for
+/// `--help` and `--version`), [`EXIT_GUARD`] for the run guard's stop ([`guard_stopped`]), 1
+/// for any other. A command ended by a signal N does not come here: it ends by the signal
+/// itself (`cli::signals`), which a shell reports as 128 + N.
 fn exit_status(outcome: &anyhow::Result<Finished>) -> i32 {
     match outcome {
         Ok(Finished::Done) => 0,
         Ok(Finished::Interrupted) => EXIT_INTERRUPTED,
         Ok(Finished::ChecksFailed) => 1,
-        Err(e) if e.chain().any(guard_stopped) => EXIT_GUARD,
-        Err(_) => 1,
+        Err(e) => match e.downcast_ref::<clap::Error>() {
+            Some(usage) => usage.exit_code(),
+            None if e.chain().any(guard_stopped) => EXIT_GUARD,
+            None => 1,
+        },
     }
 }
 
 /// Whether the error `e` (one link of a chain of causes) is the run guard's stop: a
-/// [`Failure`], a [`RunError::Guard`], or a [`RunError::Other`] that holds one.
+/// [`Failure`], or the run loop's [`RunError::Guard`].
 fn guard_stopped(e: &(dyn Error + 'static)) -> bool {
-    match e.downcast_ref::<RunError>() {
-        Some(RunError::Guard(_)) => true,
-        Some(RunError::Other(inner)) => inner.chain().any(guard_stopped),
-        None => e.is::<Failure>(),
-    }
+    matches!(e.downcast_ref::<RunError>(), Some(RunError::Guard(_))) || e.is::<Failure>()
 }
 
 #[cfg(test)]
@@ -147,8 +157,8 @@ mod tests {
     }
 
     /// The run guard's stop exits with [`EXIT_GUARD`] however it is carried: as it is, inside
-    /// the run loop's error, under context added by the layers above, or inside the run loop's
-    /// other errors; every other error exits with 1.
+    /// the run loop's error, under context added by the layers above; every other error exits
+    /// with 1, the run loop's other errors included.
     #[test]
     fn the_guard_s_stop_exits_with_its_status_however_it_is_wrapped() {
         use anyhow::Context;
@@ -159,23 +169,55 @@ mod tests {
         assert_eq!(status(wrapped.unwrap_err()), EXIT_GUARD);
         let carried = Err::<(), _>(failure())
             .context("the reference run")
-            .unwrap_err();
-        assert_eq!(status(RunError::Other(carried).into()), EXIT_GUARD);
+            .context("variant dt/2");
+        assert_eq!(status(carried.unwrap_err()), EXIT_GUARD);
         assert_eq!(status(anyhow::anyhow!("cannot read a.data")), 1);
-        let other = RunError::Other(anyhow::anyhow!("disk full"));
-        assert_eq!(status(other.into()), 1);
+        let disk = std::io::Error::new(std::io::ErrorKind::StorageFull, "disk full");
+        let stopped = RunError::Stopped {
+            dir: "out/x".into(),
+            kept: "last save none, last checkpoint none".into(),
+            source: Box::new(RunError::Write(disk)),
+        };
+        assert_eq!(status(stopped.into()), 1);
         // a failure flattened into text is an error like any other: the reason for the types
         assert_eq!(status(anyhow::anyhow!("{}", failure())), 1);
     }
 
-    /// The run loop's error says what the guard's failure says, to the letter.
+    /// A command line that does not parse exits with clap's usage status, 2; `--help` with 0.
+    #[test]
+    fn a_usage_error_exits_with_clap_s_status() {
+        let status = |args: &[&str]| {
+            let e = Cli::try_parse_from(args).err().expect("no command ran");
+            exit_status(&Err(e.into()))
+        };
+        assert_eq!(status(&["verdem", "run", "--threads", "0", "c.toml"]), 2);
+        assert_eq!(status(&["verdem", "no-such-command"]), 2);
+        assert_eq!(status(&["verdem", "--help"]), 0);
+    }
+
+    /// The run loop's error says what the guard's failure says, to the letter; a file it could
+    /// not write is said with what is kept, then the file's error.
     #[test]
     fn the_run_loop_s_error_keeps_the_failure_s_message() {
         let f = failure();
         let e: anyhow::Error = RunError::Guard(f.clone()).into();
         assert_eq!(format!("{e:#}"), f.to_string());
-        let inner = anyhow::anyhow!("disk full").context("save 3 was not written");
-        let e: anyhow::Error = RunError::Other(inner).into();
-        assert_eq!(format!("{e:#}"), "save 3 was not written: disk full");
+        let disk = std::io::Error::new(std::io::ErrorKind::StorageFull, "disk full");
+        let save = RunError::Save {
+            save: 3,
+            step: 30,
+            source: disk,
+        };
+        let e: anyhow::Error = RunError::Stopped {
+            dir: "out/x".into(),
+            kept: "last save none, last checkpoint none".into(),
+            source: Box::new(save),
+        }
+        .into();
+        assert_eq!(
+            format!("{e:#}"),
+            "the run stopped; the files already in out/x are intact (last save none, last \
+             checkpoint none of this run): save 3 (step 30) was not written: disk full"
+        );
     }
 }

@@ -6,11 +6,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{bail, Context};
-
-use crate::io::checkpoint::{Ledgers, Resumed, RunRecord};
+use crate::io::checkpoint::{CheckpointError, Ledgers, Resumed, RunRecord};
 use crate::io::diagnostics::{Diagnostics, CSV_HEADER};
-use crate::io::{atomic, csv_table, mercury, vtk};
+use crate::io::{atomic, csv_table, mercury, vtk, FormatError};
 use crate::state::SampledContact;
 use crate::step::guard::Failure;
 use crate::step::{Engine, Reading, StageTimes};
@@ -101,9 +99,9 @@ pub fn write_summary(
     name: &str,
     summary: &RunSummary,
     threads: usize,
-) -> anyhow::Result<()> {
+) -> Result<(), RunError> {
     let p = summary_path(dir, name);
-    Ok(atomic::write(&p, summary.toml(name, threads).as_bytes())?)
+    atomic::write(&p, summary.toml(name, threads).as_bytes()).map_err(RunError::Write)
 }
 
 /// Path of the run's checkpoint.
@@ -113,7 +111,7 @@ pub fn checkpoint_path(dir: &Path, name: &str) -> PathBuf {
 
 /// The save numbers of the series `dir/name` that have both a `.data` and a `.fstat` file,
 /// increasing (none when the folder does not exist).
-pub fn saves_of(dir: &Path, name: &str) -> anyhow::Result<Vec<u64>> {
+pub fn saves_of(dir: &Path, name: &str) -> Result<Vec<u64>, RunError> {
     let mut saves: Vec<u64> = run_files(dir, name)?
         .iter()
         .filter_map(|p| {
@@ -131,7 +129,7 @@ pub fn saves_of(dir: &Path, name: &str) -> anyhow::Result<Vec<u64>> {
 /// The files of the run `name` in `dir`, sorted: its saves (`NAME.data.NNNN`, `NAME.fstat.NNNN`,
 /// `NAME.NNNN.vtu`, `NAME.pvd`), checkpoint, diagnostics, summary, profiles, checks and
 /// pictures. Files of runs with other names are not among them.
-pub fn run_files(dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
+pub fn run_files(dir: &Path, name: &str) -> Result<Vec<PathBuf>, RunError> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(Vec::new());
     };
@@ -139,7 +137,11 @@ pub fn run_files(dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
     let prefix = format!("{name}.");
     let mut found = Vec::new();
     for entry in entries {
-        let entry = entry.with_context(|| format!("{}: cannot list", dir.display()))?;
+        let entry = entry.map_err(|source| RunError::Io {
+            path: dir.to_path_buf(),
+            what: "cannot list",
+            source,
+        })?;
         let file = entry.file_name();
         let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
             continue;
@@ -184,36 +186,24 @@ pub fn claim_output_folder(
     force: bool,
     flag: &str,
     _held: &crate::io::lock::FolderLock,
-) -> anyhow::Result<usize> {
+) -> Result<usize, RunError> {
     let found = run_files(dir, name)?;
     if found.is_empty() {
         return Ok(0);
     }
     if !force {
-        let shown: Vec<String> = found
-            .iter()
-            .take(4)
-            .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into_owned()))
-            .collect();
-        let more = match found.len() - shown.len() {
-            0 => String::new(),
-            m => format!(" and {m} more"),
-        };
-        bail!(
-            "{}: already holds the files of a run named {name:?} ({}{more}; {} files); nothing \
-             was written. Choose another output folder, continue that run with --resume \
-             CHECKPOINT, or replace its files with {flag}",
-            dir.display(),
-            shown.join(", "),
-            found.len()
-        );
+        return Err(RunError::Occupied {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            found,
+            flag: flag.to_string(),
+        });
     }
     for p in &found {
-        std::fs::remove_file(p).with_context(|| {
-            format!(
-                "{}: cannot remove (replacing the files of an earlier run, {flag})",
-                p.display()
-            )
+        std::fs::remove_file(p).map_err(|source| RunError::Remove {
+            path: p.clone(),
+            flag: flag.to_string(),
+            source,
         })?;
     }
     Ok(found.len())
@@ -242,17 +232,127 @@ pub trait Observer {
     fn state(&self) -> Vec<u8>;
 }
 
-/// Why a run stopped short of its end step.
+/// Why a run stopped short of its end step, or its output folder was refused. Every message
+/// names the file or folder.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     /// The run guard stopped it: a number it could no longer trust (`verdem run` exits with
     /// status 3). Its message names what is kept on disk.
     #[error(transparent)]
     Guard(#[from] Failure),
-    /// Anything else: a file not read or written, a refused checkpoint, an observer's error,
-    /// with its message.
+    /// A file of the run could not be written (a full disk, a read-only folder): the run
+    /// stopped there, and the files it had written in `dir` are intact (`kept`: its last save
+    /// and checkpoint). The source says which file and why.
+    #[error("the run stopped; the files already in {} are intact ({kept} of this run)", dir.display())]
+    Stopped {
+        dir: PathBuf,
+        kept: String,
+        #[source]
+        source: Box<RunError>,
+    },
+    /// Save `save` (at step `step`) could not be written whole, and its files were removed.
+    #[error("save {save} (step {step}) was not written")]
+    Save {
+        save: u64,
+        step: u64,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A checkpoint that could not be written.
     #[error(transparent)]
-    Other(#[from] anyhow::Error),
+    Checkpoint(#[from] CheckpointError),
+    /// A file or folder that cannot be created, read or listed (`what`: "cannot list").
+    #[error("{}: {what}", path.display())]
+    Io {
+        path: PathBuf,
+        what: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file not written ([`atomic::write`]'s error, which names it).
+    #[error(transparent)]
+    Write(std::io::Error),
+    /// A malformed file of the run read back (its diagnostics table, a save's header).
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    /// The diagnostics table's rows could not be kept for a resumed run.
+    #[error("{}: its rows cannot be kept", path.display())]
+    Table {
+        path: PathBuf,
+        #[source]
+        source: csv::Error,
+    },
+    /// The output folder holds the files of an earlier run named `name` (all of them in
+    /// `found`), and `flag` (the option that replaces them) was not given.
+    #[error(
+        "{}: already holds the files of a run named {name:?} ({}); nothing was written. Choose \
+         another output folder, continue that run with --resume CHECKPOINT, or replace its \
+         files with {flag}",
+        dir.display(),
+        listed_files(found)
+    )]
+    Occupied {
+        dir: PathBuf,
+        name: String,
+        found: Vec<PathBuf>,
+        flag: String,
+    },
+    /// A file of an earlier run that `flag` asked to replace but cannot be removed.
+    #[error(
+        "{}: cannot remove (replacing the files of an earlier run, {flag})",
+        path.display()
+    )]
+    Remove {
+        path: PathBuf,
+        flag: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A resumed run's diagnostics table (`file`, its `line`) holds save `save` at step `step`,
+    /// which this run, saving every `save_every` steps, would number otherwise; `written_every`
+    /// is the interval that wrote it, when one whole interval did.
+    #[error(
+        "{file}:{line}: save {save} is at step {step}, but this run saves every {save_every} \
+         steps; resume with {}",
+        written_every.map_or("the --save-every of the run that wrote it".into(), |e| format!(
+            "--save-every {e}"
+        ))
+    )]
+    SaveInterval {
+        file: String,
+        line: usize,
+        save: u64,
+        step: u64,
+        save_every: u64,
+        written_every: Option<u64>,
+    },
+    /// A checkpoint's ledgers read at the save of step `read_at`, while saves every
+    /// `save_every` steps put the last save before the resumed step `step` at `last_save`.
+    #[error(
+        "the checkpoint's ledgers were read at the save of step {read_at}, but with a save \
+         every {save_every} steps the last save before step {step} is at step {last_save}: \
+         resume with the --save-every of the run that wrote it"
+    )]
+    LedgersAt {
+        read_at: u64,
+        save_every: u64,
+        step: u64,
+        last_save: u64,
+    },
+}
+
+/// The first four of `found` by name and how many there are, for [`RunError::Occupied`].
+fn listed_files(found: &[PathBuf]) -> String {
+    let shown: Vec<String> = found
+        .iter()
+        .take(4)
+        .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into_owned()))
+        .collect();
+    let more = match found.len() - shown.len() {
+        0 => String::new(),
+        m => format!(" and {m} more"),
+    };
+    format!("{}{more}; {} files", shown.join(", "), found.len())
 }
 
 /// Where a run starts.
@@ -313,19 +413,19 @@ fn reading_at_start(
     engine: &dyn Engine,
     start: Start<'_>,
     save_every: u64,
-) -> anyhow::Result<Option<Reading>> {
+) -> Result<Option<Reading>, RunError> {
     let step = engine.state().step;
     Ok(match start {
         Start::Fresh => None,
         Start::Resumed(Some(l)) => {
             let last_save = step / save_every * save_every;
             if let Some(r) = l.last_save.filter(|r| r.step != last_save) {
-                bail!(
-                    "the checkpoint's ledgers were read at the save of step {}, but with a save \
-                     every {save_every} steps the last save before step {step} is at step \
-                     {last_save}: resume with the --save-every of the run that wrote it",
-                    r.step
-                );
+                return Err(RunError::LedgersAt {
+                    read_at: r.step,
+                    save_every,
+                    step,
+                    last_save,
+                });
             }
             l.last_save
         }
@@ -342,8 +442,11 @@ fn run_from(
     mut observer: Option<&mut dyn Observer>,
 ) -> Result<RunSummary, RunError> {
     let resumed = matches!(start, Start::Resumed(_));
-    std::fs::create_dir_all(&opts.out_dir)
-        .with_context(|| format!("{}: cannot create output folder", opts.out_dir.display()))?;
+    std::fs::create_dir_all(&opts.out_dir).map_err(|source| RunError::Io {
+        path: opts.out_dir.clone(),
+        what: "cannot create output folder",
+        source,
+    })?;
     let diag = diagnostics_path(&opts.out_dir, &opts.name);
     // What a stop leaves: the last save and checkpoint of this run.
     let mut kept = Kept::default();
@@ -471,7 +574,7 @@ fn write_checkpoint(
     engine: &dyn Engine,
     opts: &RunOptions,
     record: &RunRecord,
-) -> anyhow::Result<()> {
+) -> Result<(), CheckpointError> {
     crate::io::checkpoint::write_run(
         &checkpoint_path(&opts.out_dir, &opts.name),
         &engine.snapshot(),
@@ -500,12 +603,12 @@ impl Kept {
 
     /// The error of a run stopped because a file could not be written (a full disk, a
     /// read-only folder): the file and the system's error, then what is kept on disk.
-    fn not_written(&self, e: anyhow::Error, dir: &Path) -> anyhow::Error {
-        e.context(format!(
-            "the run stopped; the files already in {} are intact ({} of this run)",
-            dir.display(),
-            self.listed()
-        ))
+    fn not_written(&self, e: impl Into<RunError>, dir: &Path) -> RunError {
+        RunError::Stopped {
+            dir: dir.to_path_buf(),
+            kept: self.listed(),
+            source: Box::new(e.into()),
+        }
     }
 
     fn listed(&self) -> String {
@@ -531,7 +634,7 @@ fn write_save(
     diag: &Path,
     vtk_series: Option<&mut vtk::Series>,
     ledger: Option<crate::step::LedgerRow>,
-) -> anyhow::Result<PathBuf> {
+) -> Result<PathBuf, RunError> {
     let core = &engine.snapshot();
     let k = core.step / opts.save_every;
     let data = mercury::save_path(&opts.out_dir, &opts.name, "data", k);
@@ -556,9 +659,11 @@ fn write_save(
         for p in &replaced {
             let _ = std::fs::remove_file(p);
         }
-        return Err(
-            anyhow::Error::new(e).context(format!("save {k} (step {}) was not written", core.step))
-        );
+        return Err(RunError::Save {
+            save: k,
+            step: core.step,
+            source: e,
+        });
     }
     Ok(data)
 }
@@ -571,7 +676,7 @@ fn prepare_diagnostics(
     step: u64,
     save_every: u64,
     resumed: bool,
-) -> anyhow::Result<()> {
+) -> Result<(), RunError> {
     let mut kept = csv::WriterBuilder::new()
         .has_headers(false)
         .from_writer(CSV_HEADER.as_bytes().to_vec());
@@ -580,7 +685,11 @@ fn prepare_diagnostics(
         // that cannot be read is an error, never taken for an empty one.
         let old = match std::fs::read_to_string(path) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-            read => read.with_context(|| format!("{}: cannot read", path.display()))?,
+            read => read.map_err(|source| RunError::Io {
+                path: path.to_path_buf(),
+                what: "cannot read",
+                source,
+            })?,
         };
         let file = path.display().to_string();
         for record in csv_table::records(&file, &old, false) {
@@ -593,20 +702,27 @@ fn prepare_diagnostics(
                 continue;
             }
             if save * save_every != row_step {
-                let written_every = match row_step.checked_div(save) {
-                    Some(e) if e * save == row_step => format!("--save-every {e}"),
-                    _ => "the --save-every of the run that wrote it".into(),
-                };
-                bail!(
-                    "{file}:{line}: save {save} is at step {row_step}, but this run saves every \
-                     {save_every} steps; resume with {written_every}"
-                );
+                return Err(RunError::SaveInterval {
+                    file: file.clone(),
+                    line,
+                    save,
+                    step: row_step,
+                    save_every,
+                    written_every: row_step.checked_div(save).filter(|e| e * save == row_step),
+                });
             }
-            kept.write_record(&record)?;
+            kept.write_record(&record)
+                .map_err(|source| RunError::Table {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
         }
     }
-    let text = kept.into_inner()?;
-    Ok(atomic::write(path, &text)?)
+    let text = kept.into_inner().map_err(|e| RunError::Table {
+        path: path.to_path_buf(),
+        source: e.into_error().into(),
+    })?;
+    atomic::write(path, &text).map_err(RunError::Write)
 }
 
 fn progress_bar(opts: &RunOptions, start: u64) -> Option<indicatif::ProgressBar> {

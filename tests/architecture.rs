@@ -315,3 +315,24 @@ fn a_planted_upward_import_is_caught() {
          docs/architecture.md's layers"
     );
 }
+
+/// The solver and its files (`run` and every layer below it) return their own error types, so
+/// that a program embedding the library can match on them: none of their code uses `anyhow`
+/// (the tools above may).
+#[test]
+fn the_solver_s_layers_return_their_own_error_types() {
+    let depth = documented_layers();
+    let run = depth["run"];
+    let files = library_files(&root());
+    let solver: Vec<&(PathBuf, String)> = files
+        .iter()
+        .filter(|(rel, _)| depth.get(&module_path(rel)[0]).is_some_and(|&d| d >= run))
+        .collect();
+    assert!(solver.len() > 40, "the solver's files are read");
+    let users: Vec<String> = solver
+        .iter()
+        .filter(|(_, text)| code_of(text).contains("anyhow"))
+        .map(|(rel, _)| rel.display().to_string())
+        .collect();
+    assert!(users.is_empty(), "anyhow in the solver's layers: {users:?}");
+}

@@ -1,9 +1,10 @@
 //! `docs/extending.md`'s recipes for a tangential convention and a normal law, applied
 //! literally to a copy of the crate: a toy convention (the objective law with a 1.0001 × kt
 //! spring) as one registry line, a toy damping (the linear spring with a 1.0001 × γn dashpot)
-//! as one new file and one registry line. The change must be exactly those, the copy must build,
-//! its `verdem verify` must judge the toy convention's rows and its `verdem run` of a case
-//! naming the toy damping must run under the run guard.
+//! as one new file and one registry line. The change must be exactly those (beside the toy
+//! peer of `tests/recipe_peer.rs`, which shares the copy: `scratch::every_recipe`), the copy
+//! must build, its `verdem verify` must judge the toy convention's rows and its `verdem run` of
+//! a case naming the toy damping must run under the run guard.
 
 mod common;
 #[path = "common/scratch.rs"]
@@ -12,42 +13,7 @@ mod scratch;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use scratch::{Change, Scratch};
-
-/// The recipe's registry line of the toy convention.
-const TOY_CONVENTION: &str = r#"    Stiffer = "toy-stiffer", |p| Objective::new(1.0001 * p.kt, p.gammat, p.mu), [objective, twists_spring], "Toy: the objective law with a 1.0001 x kt spring";"#;
-
-/// The recipe's registry line of the toy damping.
-const TOY_DAMPING: &str = r#"    ToyDamping = "toy-damping", mod toy_damping, |p| toy_damping::ToyDamping { kn: p.kn, gamman: 1.0001 * p.gamman }, "Toy: the linear spring with a 1.0001 x gamman dashpot";"#;
-
-/// The recipe's new file of the toy damping.
-const TOY_DAMPING_FILE: &str = r#"//! A toy damping: a linear spring and an absolute dashpot, fn = kn·δ − γn·vn.
-
-use crate::contact::NormalModel;
-
-/// Spring kn (force/length) and absolute dashpot γn (mass/time).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ToyDamping {
-    pub kn: f64,
-    pub gamman: f64,
-}
-
-impl NormalModel for ToyDamping {
-    fn force(&self, delta: f64, vn: f64) -> f64 {
-        self.kn * delta - self.gamman * vn
-    }
-
-    fn stored_energy(&self, delta: f64) -> f64 {
-        0.5 * self.kn * delta * delta
-    }
-
-    const SPLITS_DISSIPATION: bool = true;
-
-    fn dissipated(&self, _delta: f64, vn: f64, _fn_signed: f64, dt: f64) -> f64 {
-        self.gamman * vn * vn * dt
-    }
-}
-"#;
+use scratch::{Change, TOY_CONVENTION, TOY_DAMPING, TOY_DAMPING_FILE};
 
 /// The rows of a `verdem verify` table: case, quantity and result, by case and quantity. A row
 /// ends in five words (expected, measured, tolerance, its kind, result); before them the case
@@ -118,40 +84,23 @@ fn the_documented_recipes_add_a_tangential_convention_and_a_damping_that_verify_
         assert!(docs.contains(form), "docs/extending.md no longer gives {form}");
     }
 
-    let s = Scratch::copy_crate(&root);
-    s.insert_line(
-        "src/contact/registry.rs",
-        "conventions! {",
-        "}",
-        TOY_CONVENTION,
-    );
-    s.insert_line(
-        "src/contact/normal_laws.rs",
-        "normal_laws! {",
-        "}",
-        TOY_DAMPING,
-    );
-    s.create("src/contact/normal_laws/toy_damping.rs", TOY_DAMPING_FILE);
+    let shared = scratch::every_recipe(&root);
+    let changes = shared.scratch.changes();
+    assert_eq!(changes, scratch::expected_changes());
+    // this test's recipes: one line in each registry, one new file
     let one_line = |line: &str| Change::Lines {
         added: vec![line.to_string()],
         removed: vec![],
     };
-    let expected = BTreeMap::from([
-        (
-            "src/contact/normal_laws.rs".to_string(),
-            one_line(TOY_DAMPING),
-        ),
-        (
-            "src/contact/normal_laws/toy_damping.rs".to_string(),
-            Change::New,
-        ),
-        (
-            "src/contact/registry.rs".to_string(),
-            one_line(TOY_CONVENTION),
-        ),
+    let ours = BTreeMap::from([
+        ("src/contact/normal_laws.rs", one_line(TOY_DAMPING)),
+        ("src/contact/normal_laws/toy_damping.rs", Change::New),
+        ("src/contact/registry.rs", one_line(TOY_CONVENTION)),
     ]);
-    assert_eq!(s.changes(), expected);
-    let bin = s.build();
+    for (file, change) in &ours {
+        assert_eq!(changes.get(*file), Some(change), "{file}");
+    }
+    let bin = shared.bin;
     let built = started.elapsed();
 
     // verify: every row of the objective law has the toy's, judged; the rows the toy's
@@ -216,8 +165,18 @@ fn the_documented_recipes_add_a_tangential_convention_and_a_damping_that_verify_
     assert_eq!(hashes[0], own_hash, "the default law changed with the toys");
     assert_ne!(hashes[1], hashes[0], "the toy damping had no effect");
     eprintln!(
-        "recipe: copy and build {:.0} s, verify {:.0} s, runs {:.0} s",
+        "recipe: the toy convention is 1 registry line, the toy damping 1 registry line and a \
+         file of {} lines",
+        TOY_DAMPING_FILE.lines().count()
+    );
+    eprintln!(
+        "recipe: copy and build {:.0} s ({}), verify {:.0} s, runs {:.0} s",
         built.as_secs_f64(),
+        if shared.built_here {
+            "built here"
+        } else {
+            "the suite's build, reused"
+        },
         (verified - built).as_secs_f64(),
         (started.elapsed() - verified).as_secs_f64()
     );

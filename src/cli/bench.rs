@@ -10,6 +10,7 @@ use verdem::case::Case;
 use verdem::child::{self, OnParentDeath};
 use verdem::contact::named;
 use verdem::io::atomic;
+use verdem::peers::Peer;
 use verdem::scene;
 
 use super::args::count;
@@ -20,10 +21,6 @@ const DEVELOPING: &str = "data/states/mercury_t143.85.data";
 
 /// The state a sweep tiles: verdem's full run's final state, so that every code starts steady.
 const STEADY: &str = "golden/full_run/shear_flow.final.data";
-
-/// The peers a sweep times unless --peers names others (Yade and Kratos, far slower, when
-/// named).
-const SWEPT_PEERS: &str = "lammps,liggghts";
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -46,10 +43,7 @@ pub struct Args {
     /// verdem thread counts.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
     threads: Vec<usize>,
-    /// Peers to run, comma-separated (`verdem peers` lists them; none: --peers ''). The default
-    /// leaves out Kratos DEM, about 100 times slower than LAMMPS: name it, with fewer --steps;
-    /// with --scale it is lammps,liggghts (name Yade and Kratos to sweep them too).
-    #[arg(long)]
+    #[arg(long, help = peers_help())]
     peers: Option<String>,
     /// MPI ranks (Yade: OpenMP threads) for the peers.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = count::<usize>)]
@@ -83,6 +77,49 @@ pub struct Args {
     /// Also write the goals as a JSON table to this file (docs/cli.md, "Reports for CI").
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+}
+
+/// The names of the known peers that `pick` selects, in the registry's order, joined by `sep`.
+fn names(pick: impl Fn(&dyn Peer) -> bool, sep: &str) -> String {
+    let picked: Vec<&str> = verdem::peers::all()
+        .iter()
+        .filter(|p| pick(**p))
+        .map(|p| p.name())
+        .collect();
+    picked.join(sep)
+}
+
+/// `names` as a sentence lists them: `a`, `a and b`, `a, b and c`.
+fn and_list(names: &str) -> String {
+    match names.rsplit_once(", ") {
+        Some((head, last)) => format!("{head} and {last}"),
+        None => names.to_string(),
+    }
+}
+
+/// The help of `--peers`: which peers the defaults leave out, from what each declares
+/// ([`Peer::timed_by_default`], [`Peer::swept_by_default`]).
+fn peers_help() -> String {
+    let slow = names(|p| !p.timed_by_default(), ", ");
+    let timed = match (slow.is_empty(), slow.contains(", ")) {
+        (true, _) => "The default times every peer".to_string(),
+        (false, many) => format!(
+            "The default leaves out {}, too slow for its rounds: name {}, with fewer --steps",
+            and_list(&slow),
+            if many { "them" } else { "it" }
+        ),
+    };
+    let unswept = names(|p| !p.swept_by_default(), ", ");
+    let named = if unswept.is_empty() {
+        String::new()
+    } else {
+        format!(" (name {} to sweep them too)", and_list(&unswept))
+    };
+    format!(
+        "Peers to run, comma-separated (`verdem peers` lists them; none: --peers ''). {timed}; \
+         with --scale it is {}{named}",
+        names(|p| p.swept_by_default(), ",")
+    )
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {
@@ -128,7 +165,7 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
         if a.scale.is_empty() {
             verdem::peers::bench_names()
         } else {
-            SWEPT_PEERS.to_string()
+            names(|p| p.swept_by_default(), ",")
         }
     });
     for peer in verdem::peers::parse_list(&peers).context("--peers")? {

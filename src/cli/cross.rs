@@ -44,12 +44,7 @@ pub struct Args {
         value_parser = described(&Tangential::ALL, Tangential::name, Tangential::description)
     )]
     convention: Option<Tangential>,
-    /// Average in-run too (LAMMPS, LIGGGHTS and Yade), in the peer (from dumps every K and KP
-    /// steps), in verdem with the peer's convention and in verdem with the case's own
-    /// convention, over the same steps; writes PEER.profiles_inrun.csv,
-    /// verdem.profiles_inrun.csv, verdem_own.profiles_inrun.csv and inrun.md, their core means
-    /// compared with 95 % intervals (docs/peers-inrun.md).
-    #[arg(long)]
+    #[arg(long, help = inrun_help())]
     inrun: bool,
     /// With --inrun: contact stress and wall forces every K steps (default: 8 contact
     /// durations, as `verdem run`); K must divide --every.
@@ -186,6 +181,28 @@ fn core_mean_case(suite: &str, a: &str, b: &str, d: &Difference, judged: bool) -
             Detail::new("half_width_95", d.half_width(), undefined),
             Detail::new("chi2_per_dof", d.chi2, "no error bars"),
         ])
+}
+
+/// The help of `--inrun`, naming the peers that declare in-run dumps
+/// ([`Peer::has_inrun_dumps`]).
+fn inrun_help() -> String {
+    let with: Vec<&str> = verdem::peers::all()
+        .iter()
+        .filter(|p| p.has_inrun_dumps())
+        .map(|p| p.name())
+        .collect();
+    let listed = match with.split_last() {
+        Some((last, [])) => last.to_string(),
+        Some((last, head)) => format!("{} and {last}", head.join(", ")),
+        None => "no peer has its dumps yet".into(),
+    };
+    format!(
+        "Average in-run too ({listed}), in the peer (from dumps every K and KP steps), in verdem \
+         with the peer's convention and in verdem with the case's own convention, over the same \
+         steps; writes PEER.profiles_inrun.csv, verdem.profiles_inrun.csv, \
+         verdem_own.profiles_inrun.csv and inrun.md, their core means compared with 95 % \
+         intervals (docs/peers-inrun.md)"
+    )
 }
 
 pub fn exec(a: Args) -> anyhow::Result<Finished> {

@@ -6,9 +6,8 @@
 //! when it is. A SHA-256 checksum of the file closes it, so that a checkpoint changed since it
 //! was written (a flipped bit, a cut) is refused before anything is restored.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context};
 use sha2::{Digest, Sha256};
 
 use crate::contact::PairForce;
@@ -100,6 +99,104 @@ impl Resumed {
     }
 }
 
+/// Why a checkpoint was not written, or was refused when read. Every message names the file
+/// (as the caller gave it), and the byte where one applies.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    /// The file cannot be read (the system's error is the source).
+    #[error("{}: cannot read checkpoint", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file cannot be written ([`crate::io::atomic::write`]'s error, which names it).
+    #[error(transparent)]
+    Write(std::io::Error),
+    /// Not a verdem checkpoint (its first bytes are no checkpoint's magic).
+    #[error("{file}: not a verdem checkpoint")]
+    NotCheckpoint { file: String },
+    /// A format version this verdem does not read (1, an earlier verdem's, had no version
+    /// field).
+    #[error(
+        "{file}: checkpoint format version {version}{}, this verdem reads versions \
+         {WITHOUT_RECORD} to {FORMAT_VERSION}: resume with the verdem that wrote it, or rerun",
+        if *version == 1 { " (an earlier verdem)" } else { "" }
+    )]
+    Version { file: String, version: u64 },
+    /// The checksum is not the SHA-256 of the bytes before it: changed since it was written.
+    #[error(
+        "{file}: refused, a corrupted checkpoint (changed or truncated since it was written): \
+         its checksum says SHA-256 {stored}…, its {len} bytes before it have {found}…"
+    )]
+    Corrupt {
+        file: String,
+        /// The first 8 bytes of the stored and of the computed digest, in hex.
+        stored: String,
+        found: String,
+        /// The bytes before the checksum.
+        len: usize,
+    },
+    /// The file ends before a field: `what` truncated at byte `at` of `len`, `more` bytes
+    /// short.
+    #[error("{file}: {what} truncated at byte {at} (of {len}; {more} more expected)")]
+    Truncated {
+        file: String,
+        what: &'static str,
+        at: usize,
+        len: usize,
+        more: usize,
+    },
+    /// A malformed field: a count the file cannot hold, a flag neither 0 nor 1, a number that
+    /// is not finite, a contact between particles the case does not have, trailing bytes, a
+    /// file too short for its checksum.
+    #[error("{file}: {}{msg}", at.map_or(String::new(), |at| format!("byte {at}: ")))]
+    Format {
+        file: String,
+        /// The byte the field starts at, when the message is about one.
+        at: Option<usize>,
+        msg: String,
+    },
+    /// A checkpoint of another run: every field that differs from the case's (its name, its
+    /// tangential convention, the particle count, dt, the history words per contact).
+    #[error("{file}: refused, a checkpoint of another run: {}", differs.join("; "))]
+    OtherRun { file: String, differs: Vec<String> },
+    /// Ledgers of a contact law that splits its dissipation otherwise than the case's.
+    #[error(
+        "{file}: byte {at}: ledgers: refused, a checkpoint of another contact law: its law {} \
+         its dissipation, the case's {}",
+        splits_text(*theirs),
+        splits_text(*ours)
+    )]
+    OtherLaw {
+        file: String,
+        at: usize,
+        /// Whether the checkpoint's law and the case's split their dissipation.
+        theirs: bool,
+        ours: bool,
+    },
+}
+
+/// How [`CheckpointError::OtherLaw`] says whether a law splits its dissipation.
+fn splits_text(splits: bool) -> &'static str {
+    if splits {
+        "splits"
+    } else {
+        "does not split"
+    }
+}
+
+impl CheckpointError {
+    /// A malformed field of `file` at byte `at` (if any).
+    fn format(file: &str, at: Option<usize>, msg: String) -> CheckpointError {
+        CheckpointError::Format {
+            file: file.to_string(),
+            at,
+            msg,
+        }
+    }
+}
+
 /// The tag of a run of `case`: what a checkpoint must share with the case it resumes, as
 /// `key=value` lines (the case's name and its tangential convention, which fixes what a
 /// contact's history words mean). Read compares it field by field, and names the fields that
@@ -116,7 +213,7 @@ pub fn tag(case: &crate::case::Case) -> String {
 /// Writes a checkpoint of a state advanced with time step `dt` without a run record (its
 /// resume starts the ledgers again: [`Resumed::lacks`]); `tag` identifies the case (checked on
 /// resume; see [`tag`]).
-pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> anyhow::Result<()> {
+pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> Result<(), CheckpointError> {
     write_run(path, core, dt, tag, &RunRecord::default())
 }
 
@@ -133,7 +230,7 @@ pub fn write_run(
     dt: f64,
     tag: &str,
     record: &RunRecord,
-) -> anyhow::Result<()> {
+) -> Result<(), CheckpointError> {
     let mut b = Vec::new();
     b.extend_from_slice(MAGIC);
     b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -190,7 +287,7 @@ pub fn write_run(
     }
     let sum = Sha256::digest(&b);
     b.extend_from_slice(&sum);
-    Ok(crate::io::atomic::write(path, &b)?)
+    crate::io::atomic::write(path, &b).map_err(CheckpointError::Write)
 }
 
 /// The first 8 bytes of `digest` in hex, as messages show a checksum.
@@ -200,23 +297,26 @@ fn short_hex(digest: &[u8]) -> String {
 
 /// The bytes of the checkpoint `bytes` of `file` before its checksum, once the checksum is
 /// theirs; else an error naming the file and both digests.
-fn checked_body<'a>(file: &str, bytes: &'a [u8]) -> anyhow::Result<&'a [u8]> {
+fn checked_body<'a>(file: &str, bytes: &'a [u8]) -> Result<&'a [u8], CheckpointError> {
     let Some(split) = bytes.len().checked_sub(CHECKSUM_LEN) else {
-        bail!(
-            "{file}: checkpoint truncated: {} bytes, too few for its checksum",
-            bytes.len()
-        );
+        return Err(CheckpointError::format(
+            file,
+            None,
+            format!(
+                "checkpoint truncated: {} bytes, too few for its checksum",
+                bytes.len()
+            ),
+        ));
     };
     let (body, stored) = bytes.split_at(split);
     let found = Sha256::digest(body);
     if found.as_slice() != stored {
-        bail!(
-            "{file}: refused, a corrupted checkpoint (changed or truncated since it was \
-             written): its checksum says SHA-256 {}…, its {} bytes before it have {}…",
-            short_hex(stored),
-            body.len(),
-            short_hex(&found)
-        );
+        return Err(CheckpointError::Corrupt {
+            file: file.to_string(),
+            stored: short_hex(stored),
+            found: short_hex(&found),
+            len: body.len(),
+        });
     }
     Ok(body)
 }
@@ -282,71 +382,72 @@ impl<'a> Reader<'a> {
         self.base + self.at
     }
 
+    /// An error at byte `at` of the file: `msg` about the field there.
+    pub fn error(&self, at: usize, msg: String) -> CheckpointError {
+        CheckpointError::format(&self.file, Some(at), msg)
+    }
+
     /// The next `n` bytes.
-    pub fn take(&mut self, n: usize) -> anyhow::Result<&'a [u8]> {
+    pub fn take(&mut self, n: usize) -> Result<&'a [u8], CheckpointError> {
         if n > self.b.len() - self.at {
-            bail!(
-                "{}: {} truncated at byte {} (of {}; {n} more expected)",
-                self.file,
-                self.what,
-                self.at(),
-                self.base + self.b.len()
-            );
+            return Err(CheckpointError::Truncated {
+                file: self.file.clone(),
+                what: self.what,
+                at: self.at(),
+                len: self.base + self.b.len(),
+                more: n,
+            });
         }
         self.at += n;
         Ok(&self.b[self.at - n..self.at])
     }
-    pub fn u64(&mut self) -> anyhow::Result<u64> {
+    pub fn u64(&mut self) -> Result<u64, CheckpointError> {
         let mut w = [0; 8];
         w.copy_from_slice(self.take(8)?);
         Ok(u64::from_le_bytes(w))
     }
-    fn u32(&mut self) -> anyhow::Result<u32> {
+    fn u32(&mut self) -> Result<u32, CheckpointError> {
         let mut w = [0; 4];
         w.copy_from_slice(self.take(4)?);
         Ok(u32::from_le_bytes(w))
     }
-    fn i128(&mut self) -> anyhow::Result<i128> {
+    fn i128(&mut self) -> Result<i128, CheckpointError> {
         let mut w = [0; 16];
         w.copy_from_slice(self.take(16)?);
         Ok(i128::from_le_bytes(w))
     }
     /// A count of at most `most`, or an error naming `what` and where it is.
-    pub fn count(&mut self, most: usize, what: &dyn Fn() -> String) -> anyhow::Result<usize> {
+    pub fn count(
+        &mut self,
+        most: usize,
+        what: &dyn Fn() -> String,
+    ) -> Result<usize, CheckpointError> {
         let at = self.at();
         let n = self.u64()?;
         match usize::try_from(n) {
             Ok(n) if n <= most => Ok(n),
-            _ => bail!(
-                "{}: byte {at}: {} is {n}, more than {most}",
-                self.file,
-                what()
-            ),
+            _ => Err(self.error(at, format!("{} is {n}, more than {most}", what()))),
         }
     }
     /// A flag, 0 or 1, or an error naming `what` and where it is.
-    pub fn flag(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<bool> {
+    pub fn flag(&mut self, what: &dyn Fn() -> String) -> Result<bool, CheckpointError> {
         let at = self.at();
         match self.u64()? {
             0 => Ok(false),
             1 => Ok(true),
-            v => bail!(
-                "{}: byte {at}: {} is {v}, neither 0 nor 1",
-                self.file,
-                what()
-            ),
+            v => Err(self.error(at, format!("{} is {v}, neither 0 nor 1", what()))),
         }
     }
     /// A finite f64, or an error naming `what` and where it is.
-    pub fn f64(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<f64> {
+    pub fn f64(&mut self, what: &dyn Fn() -> String) -> Result<f64, CheckpointError> {
         let at = self.at();
         let v = f64::from_bits(self.u64()?);
         if !v.is_finite() {
-            bail!("{}: byte {at}: {} is not finite ({v})", self.file, what());
+            return Err(self.error(at, format!("{} is not finite ({v})", what())));
         }
         Ok(v)
     }
-    pub fn vec(&mut self, what: &dyn Fn() -> String) -> anyhow::Result<Vec3> {
+    pub fn vec(&mut self, what: &dyn Fn() -> String) -> Result<Vec3, CheckpointError> {
         let mut v = Vec3::zeros();
         for k in 0..3 {
             v[k] = self.f64(&|| format!("{}[{k}]", what()))?;
@@ -354,18 +455,21 @@ impl<'a> Reader<'a> {
         Ok(v)
     }
     /// An error unless every byte has been read.
-    pub fn end(&self) -> anyhow::Result<()> {
+    pub fn end(&self) -> Result<(), CheckpointError> {
         if self.at != self.b.len() {
-            bail!(
-                "{}: {} trailing bytes after the {}",
-                self.file,
-                self.b.len() - self.at,
-                self.what
-            );
+            return Err(CheckpointError::format(
+                &self.file,
+                None,
+                format!(
+                    "{} trailing bytes after the {}",
+                    self.b.len() - self.at,
+                    self.what
+                ),
+            ));
         }
         Ok(())
     }
-    fn flows(&mut self) -> anyhow::Result<Flows> {
+    fn flows(&mut self) -> Result<Flows, CheckpointError> {
         let mut f = Flows {
             wall_work: self.i128()?,
             gravity_work: self.i128()?,
@@ -379,7 +483,7 @@ impl<'a> Reader<'a> {
         }
         Ok(f)
     }
-    fn reading(&mut self) -> anyhow::Result<Reading> {
+    fn reading(&mut self) -> Result<Reading, CheckpointError> {
         let step = self.u64()?;
         let dt = self.f64(&|| "ledgers: dt of the last save's reading".into())?;
         let splits = self.flag(&|| "ledgers: the last save's dissipation flag".into())?;
@@ -409,15 +513,21 @@ impl<'a> Reader<'a> {
 }
 
 /// Restores a checkpoint into `engine` (built from the same case); returns the step it holds.
-pub fn read(path: &Path, engine: &mut dyn Engine, tag: &str) -> anyhow::Result<u64> {
+pub fn read(path: &Path, engine: &mut dyn Engine, tag: &str) -> Result<u64, CheckpointError> {
     Ok(read_run(path, engine, tag)?.step)
 }
 
 /// Restores a checkpoint into `engine` (built from the same case), the ledgers' flows among
 /// it when the checkpoint holds them; returns what it holds besides ([`Resumed`]).
-pub fn read_run(path: &Path, engine: &mut dyn Engine, tag: &str) -> anyhow::Result<Resumed> {
-    let bytes = std::fs::read(path)
-        .with_context(|| format!("{}: cannot read checkpoint", path.display()))?;
+pub fn read_run(
+    path: &Path,
+    engine: &mut dyn Engine,
+    tag: &str,
+) -> Result<Resumed, CheckpointError> {
+    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
     restore_run(&path.display().to_string(), &bytes, engine, tag)
 }
 
@@ -427,7 +537,7 @@ pub fn restore(
     bytes: &[u8],
     engine: &mut dyn Engine,
     tag: &str,
-) -> anyhow::Result<u64> {
+) -> Result<u64, CheckpointError> {
     Ok(restore_run(file, bytes, engine, tag)?.step)
 }
 
@@ -445,19 +555,22 @@ pub fn restore_run(
     bytes: &[u8],
     engine: &mut dyn Engine,
     tag: &str,
-) -> anyhow::Result<Resumed> {
-    let reads = format!(
-        "this verdem reads versions {WITHOUT_RECORD} to {FORMAT_VERSION}: resume with the verdem \
-         that wrote it, or rerun"
-    );
+) -> Result<Resumed, CheckpointError> {
     // A file too short for the magic is not a checkpoint either.
     let body = match bytes.get(..MAGIC.len()) {
         Some(m) if m == MAGIC => checked_body(file, bytes)?,
         Some(m) if m == MAGIC_UNSUMMED => bytes,
         Some(m) if m == MAGIC_V1 => {
-            bail!("{file}: checkpoint format version 1 (an earlier verdem), {reads}")
+            return Err(CheckpointError::Version {
+                file: file.to_string(),
+                version: 1,
+            })
         }
-        _ => bail!("{file}: not a verdem checkpoint"),
+        _ => {
+            return Err(CheckpointError::NotCheckpoint {
+                file: file.to_string(),
+            })
+        }
     };
     let mut r = Reader::new(file, body, 0, "checkpoint");
     let unsummed = r.take(MAGIC.len())? == MAGIC_UNSUMMED;
@@ -468,7 +581,10 @@ pub fn restore_run(
         version == FORMAT_VERSION
     };
     if !known {
-        bail!("{file}: checkpoint format version {version}, {reads}");
+        return Err(CheckpointError::Version {
+            file: file.to_string(),
+            version,
+        });
     }
     let tag_len = r.u64()?;
     let file_tag = String::from_utf8_lossy(r.take(usize::try_from(tag_len).unwrap_or(usize::MAX))?)
@@ -488,10 +604,10 @@ pub fn restore_run(
         differs.push(format!("dt {dt}, the case's {case_dt} (run.dt)"));
     }
     if !differs.is_empty() {
-        bail!(
-            "{file}: refused, a checkpoint of another run: {}",
-            differs.join("; ")
-        );
+        return Err(CheckpointError::OtherRun {
+            file: file.to_string(),
+            differs,
+        });
     }
     let mut snap = engine.snapshot();
     snap.step = step;
@@ -509,34 +625,43 @@ pub fn restore_run(
     let contacts = r.u64()?;
     let case_words = engine.history_words();
     if contacts > 0 && words != case_words as u64 {
-        bail!(
-            "{file}: refused, a checkpoint of another run: {words} history words per contact, the case's \
-             law {case_words} (another contact law)"
-        );
+        return Err(CheckpointError::OtherRun {
+            file: file.to_string(),
+            differs: vec![format!(
+                "{words} history words per contact, the case's law {case_words} (another \
+                 contact law)"
+            )],
+        });
     }
     // p and i, the history words, f, the two torques and fn (bytes)
     let contact_len = 8 + 8 * case_words + 8 * 10;
     let room = (r.b.len() - r.at) / contact_len;
     if contacts > room as u64 {
-        bail!(
-            "{file}: byte {contacts_at}: the contact count is {contacts}, more than the {room} \
-             the rest of the checkpoint can hold"
-        );
+        return Err(r.error(
+            contacts_at,
+            format!(
+                "the contact count is {contacts}, more than the {room} the rest of the \
+                 checkpoint can hold"
+            ),
+        ));
     }
     snap.contacts.clear();
     for c in 0..contacts {
         let at = r.at;
         let (cp, ci) = (r.u32()?, r.u32()?);
         if cp as usize >= particles || ci as usize >= particles || cp == ci {
-            bail!(
-                "{file}: byte {at}: contact {c} between particles {cp} and {ci} (0-based): not \
-                 two of the case's {particles}"
-            );
+            return Err(r.error(
+                at,
+                format!(
+                    "contact {c} between particles {cp} and {ci} (0-based): not two of the \
+                     case's {particles}"
+                ),
+            ));
         }
         let what = |q: &'static str| move || format!("contact {c}: {q}");
         let history = (0..case_words)
             .map(|_| r.f64(&what("history")))
-            .collect::<anyhow::Result<Vec<f64>>>()?;
+            .collect::<Result<Vec<f64>, _>>()?;
         let f = r.vec(&what("force"))?;
         let torque_p = r.vec(&what("torque"))?;
         let torque_i = r.vec(&what("torque"))?;
@@ -563,12 +688,14 @@ pub fn restore_run(
                 let at = r.at();
                 let reading = r.reading()?;
                 if reading.step > step || reading.dt.to_bits() != dt.to_bits() {
-                    bail!(
-                        "{file}: byte {at}: ledgers: the last save's reading is at step {} with \
-                         dt {}, not at or before the checkpoint's step {step} with dt {dt}",
-                        reading.step,
-                        reading.dt
-                    );
+                    return Err(r.error(
+                        at,
+                        format!(
+                            "ledgers: the last save's reading is at step {} with dt {}, not at \
+                             or before the checkpoint's step {step} with dt {dt}",
+                            reading.step, reading.dt
+                        ),
+                    ));
                 }
                 Some((at, reading))
             } else {
@@ -608,16 +735,15 @@ fn check_splits(
     at: usize,
     reading: &Reading,
     engine: &dyn Engine,
-) -> anyhow::Result<()> {
+) -> Result<(), CheckpointError> {
     let ours = engine.ledger().splits;
     if reading.splits != ours {
-        let says = |s: bool| if s { "splits" } else { "does not split" };
-        bail!(
-            "{file}: byte {at}: ledgers: refused, a checkpoint of another contact law: its law {} \
-             its dissipation, the case's {}",
-            says(reading.splits),
-            says(ours)
-        );
+        return Err(CheckpointError::OtherLaw {
+            file: file.to_string(),
+            at,
+            theirs: reading.splits,
+            ours,
+        });
     }
     Ok(())
 }

@@ -4,8 +4,7 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context};
-
+use super::FormatError;
 use crate::state::Motion;
 use crate::state::Snapshot;
 use crate::step::LedgerRow;
@@ -144,7 +143,7 @@ pub struct LedgerRecord {
 /// The ledgers of the diagnostics table at `path`, row by row; `None` when its header has no
 /// ledger columns (a table written before they existed). A field that is not a number, or a
 /// ledger that is only partly filled in, is an error naming the file, line and column.
-pub fn read_ledgers(path: &Path) -> anyhow::Result<Option<Vec<LedgerRecord>>> {
+pub fn read_ledgers(path: &Path) -> Result<Option<Vec<LedgerRecord>>, FormatError> {
     let (file, text) = super::read_text(path)?;
     let names: Vec<&str> = CSV_HEADER.trim_end().split(',').collect();
     let mut rows = Vec::new();
@@ -162,23 +161,28 @@ pub fn read_ledgers(path: &Path) -> anyhow::Result<Option<Vec<LedgerRecord>>> {
             }
             continue;
         };
-        let field = |k: usize| -> anyhow::Result<Option<f64>> {
+        let error = |msg: String| FormatError {
+            file: file.clone(),
+            line,
+            msg,
+        };
+        let field = |k: usize| -> Result<Option<f64>, FormatError> {
             let text = record.get(at[k]).unwrap_or("");
             if text.is_empty() {
                 return Ok(None);
             }
             match text.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(Some(v)),
-                _ => bail!(
-                    "{file}:{line}: {}: {text:?} is not a finite number",
+                _ => Err(error(format!(
+                    "{}: {text:?} is not a finite number",
                     names[k]
-                ),
+                ))),
             }
         };
-        let whole = |k: usize| -> anyhow::Result<u64> {
+        let whole = |k: usize| -> Result<u64, FormatError> {
             let text = record.get(at[k]).unwrap_or("");
             text.parse()
-                .with_context(|| format!("{file}:{line}: {}: {text:?} is not a count", names[k]))
+                .map_err(|e| error(format!("{}: {text:?} is not a count: {e}", names[k])))
         };
         let first = names.len() - LEDGER_COLUMNS;
         let v: Vec<Option<f64>> = (first..names.len()).map(field).collect::<Result<_, _>>()?;
@@ -188,10 +192,10 @@ pub fn read_ledgers(path: &Path) -> anyhow::Result<Option<Vec<LedgerRecord>>> {
             None
         } else {
             if let Some(k) = (0..LEDGER_COLUMNS).find(|&k| !optional(k) && v[k].is_none()) {
-                bail!(
-                    "{file}:{line}: {}: empty in a row with a ledger",
+                return Err(error(format!(
+                    "{}: empty in a row with a ledger",
                     names[first + k]
-                );
+                )));
             }
             let x = |k: usize| v[k].unwrap_or(0.0);
             let split = (2..5).all(|k| v[k].is_some());
@@ -213,7 +217,7 @@ pub fn read_ledgers(path: &Path) -> anyhow::Result<Option<Vec<LedgerRecord>>> {
         rows.push(LedgerRecord {
             save: whole(0)?,
             step: whole(1)?,
-            time: field(2)?.with_context(|| format!("{file}:{line}: time: empty"))?,
+            time: field(2)?.ok_or_else(|| error("time: empty".into()))?,
             ledger,
         });
     }

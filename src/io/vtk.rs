@@ -17,8 +17,8 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
-use super::fmt_f64;
 use super::mercury::{DataFile, FstatFile};
+use super::{fmt_f64, FormatError};
 use crate::contact::PairInput;
 use crate::state::{Motion, Snapshot};
 use crate::Vec3;
@@ -340,7 +340,7 @@ impl Series {
 
     /// The series `dir/name` continued after save `last` (a resumed run): the saves up to
     /// `last` that have a `.vtu` are kept in the `.pvd`, with the times of their `.data` saves.
-    pub fn resume(dir: &Path, name: &str, last: u64) -> anyhow::Result<Series> {
+    pub fn resume(dir: &Path, name: &str, last: u64) -> Result<Series, FormatError> {
         let mut series = Series::new(dir, name);
         for k in 0..=last {
             if !vtu_path(dir, name, k).exists() {
@@ -376,17 +376,16 @@ impl Series {
 }
 
 /// The time in the header of a `.data` file (its second number), read without the rest.
-fn data_time(path: &Path) -> anyhow::Result<f64> {
-    use std::io::BufRead;
-    let file = std::fs::File::open(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
-    let mut head = String::new();
-    std::io::BufReader::new(file).read_line(&mut head)?;
+fn data_time(path: &Path) -> Result<f64, FormatError> {
+    let mut lines = super::open(path)?;
+    let head = lines
+        .next_line()?
+        .map_or(String::new(), |(_, l)| l.to_string());
     head.split_whitespace()
         .nth(1)
         .and_then(|t| t.parse::<f64>().ok())
         .filter(|t| t.is_finite())
-        .ok_or_else(|| anyhow::anyhow!("{}:1: no time in the header", path.display()))
+        .ok_or_else(|| lines.error(1, "no time in the header"))
 }
 
 #[cfg(test)]

@@ -71,8 +71,8 @@ pub fn collide(
     )?;
     Ok(Outcome {
         e: (end.v[1] - end.v[0]).x / v0,
-        duration: peer.collision_duration(dir).transpose()?,
-        overlapped: peer.contact_steps(dir)?.map(|n| n as f64 * dt),
+        duration: peer.collision_duration(&run).transpose()?,
+        overlapped: peer.contact_steps(&run)?.map(|n| n as f64 * dt),
     })
 }
 

@@ -406,8 +406,8 @@ impl Peer for Kratos {
     }
 
     /// `contact_steps.txt` of a collision run.
-    fn contact_steps(&self, dir: &Path) -> anyhow::Result<Option<u64>> {
-        let path = dir.join(CONTACT_STEPS);
+    fn contact_steps(&self, run: &Run) -> anyhow::Result<Option<u64>> {
+        let path = run.dir.join(CONTACT_STEPS);
         let text = std::fs::read_to_string(&path).with_context(|| path.display().to_string())?;
         let n = text
             .trim()

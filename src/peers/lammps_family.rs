@@ -451,6 +451,10 @@ impl<D: Dialect> Peer for D {
         placed_contacts(self, run, save, s, (&path, placed), &atoms)
     }
 
+    fn has_inrun_dumps(&self) -> bool {
+        true
+    }
+
     /// [`WALLS_FILE`] of `fix ave/time` ([`wall_means`]).
     fn writes_wall_means(&self) -> bool {
         true

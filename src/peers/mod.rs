@@ -78,6 +78,19 @@ pub trait Peer: Sync {
         true
     }
 
+    /// Whether `verdem bench --scale` sweeps it when no `--peers` are given (the default: when
+    /// [`Peer::timed_by_default`]); no for a peer whose runs at the sweep's largest sizes would
+    /// take hours (it is swept when named).
+    fn swept_by_default(&self) -> bool {
+        self.timed_by_default()
+    }
+
+    /// Whether it has the dumps of in-run averaging, [`Peer::inrun_script`] (the default: no;
+    /// a peer that implements it says yes here, for the help of `verdem cross --inrun`).
+    fn has_inrun_dumps(&self) -> bool {
+        false
+    }
+
     /// Writes the state `s` (spheres of mass density `density`) in its own format into `dir`
     /// under the stem `stem`; returns the file name an input script reads.
     fn write_state(
@@ -108,15 +121,15 @@ pub trait Peer: Sync {
         Err(Lacks("it has no two-sphere collision run"))
     }
 
-    /// How long the normal force of the collision run in `dir` ([`Peer::collision_script`])
-    /// was positive (time), if the peer records it (the default: it does not).
-    fn collision_duration(&self, _dir: &Path) -> Option<anyhow::Result<f64>> {
+    /// How long the normal force of the collision run `run` ([`Peer::collision_script`]) was
+    /// positive (time), if the peer records it (the default: it does not).
+    fn collision_duration(&self, _run: &Run) -> Option<anyhow::Result<f64>> {
         None
     }
 
-    /// The number of steps the pair of a collision run in `dir` ([`Peer::collision_script`])
+    /// The number of steps the pair of the collision run `run` ([`Peer::collision_script`])
     /// overlapped at the end of a step, where the peer records it (the default: it does not).
-    fn contact_steps(&self, _dir: &Path) -> anyhow::Result<Option<u64>> {
+    fn contact_steps(&self, _run: &Run) -> anyhow::Result<Option<u64>> {
         Ok(None)
     }
 
@@ -670,6 +683,17 @@ mod tests {
             for b in &all()[k + 1..] {
                 assert!(a.name() != b.name() && a.binary() != b.binary());
             }
+        }
+    }
+
+    /// What a peer declares about its in-run dumps (the help of `verdem cross --inrun` lists
+    /// the peers from it) is what its [`Peer::inrun_script`] does.
+    #[test]
+    fn every_peer_declares_the_in_run_dumps_it_has() {
+        let case = crate::contact::named::load(Path::new("cases/shear_flow_quick.toml")).unwrap();
+        for p in all() {
+            let script = p.inrun_script(&case, "state", 100, 50, 10, 50);
+            assert_eq!(p.has_inrun_dumps(), script.is_some(), "{}", p.name());
         }
     }
 }

@@ -291,6 +291,15 @@ impl Peer for Yade {
         }))
     }
 
+    fn has_inrun_dumps(&self) -> bool {
+        true
+    }
+
+    /// Not at the sweep's largest sizes: far slower there than the LAMMPS family.
+    fn swept_by_default(&self) -> bool {
+        false
+    }
+
     /// [`super::inrun::WALLS_FILE`] of the runner `walls()` of `run.py`.
     fn writes_wall_means(&self) -> bool {
         true
@@ -431,7 +440,8 @@ impl Peer for Yade {
 
     /// `force_duration.txt`: the number of force evaluations with a positive normal force
     /// times dt.
-    fn collision_duration(&self, dir: &Path) -> Option<anyhow::Result<f64>> {
+    fn collision_duration(&self, run: &Run) -> Option<anyhow::Result<f64>> {
+        let dir = run.dir;
         Some(
             read_rows(&dir.join("force_duration.txt"), 2)
                 .map_err(anyhow::Error::from)

@@ -3,19 +3,129 @@
 
 pub mod tile;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::bail;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 
-use crate::case::{Case, Scene as SceneSpec, Search};
-use crate::io::{mercury, official};
+use crate::case::{Case, CaseError, Scene as SceneSpec, Search};
+use crate::io::{mercury, official, FormatError};
 use crate::state::Domain;
 use crate::state::{memory, Motion, Particles};
 pub use crate::step::engine::Scene;
 use crate::step::neighbor::{NeighborBuilder, PairList};
 use crate::Vec3;
+
+/// Why a scene was not built or a case not tiled ([`build`], [`tile`]). An initial file's
+/// errors name the file and the line; a case's, its file, line and field.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A malformed initial file, or one whose box is not the case's.
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    /// A case file refused when read (by [`tile::write`]).
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    /// A size whose memory the machine does not have: spheres, tiles, the neighbour list.
+    #[error(transparent)]
+    Memory(#[from] memory::TooLarge),
+    /// An initial file with another number of particles than the case's scene.
+    #[error("{}: has {found} particles, the case expects {wall} wall + {free} free", path.display())]
+    Count {
+        path: PathBuf,
+        found: usize,
+        wall: usize,
+        free: usize,
+    },
+    /// A wall sphere of an initial file that moves otherwise than the case prescribes
+    /// (velocities, length/time).
+    #[error(
+        "{}:{line}: wall sphere {id} moves at {found:?}, the case prescribes {prescribed:?}",
+        path.display()
+    )]
+    WallMotion {
+        path: PathBuf,
+        line: usize,
+        /// The sphere's id (from 1, in file order).
+        id: usize,
+        found: [f64; 3],
+        prescribed: [f64; 3],
+    },
+    /// A centre of an initial file outside the case's box along `axis`.
+    #[error(
+        "{}:{line}: particle {id}: {axis} = {value} is outside the case's box [{lo}, {hi}]",
+        path.display()
+    )]
+    Outside {
+        path: PathBuf,
+        line: usize,
+        id: usize,
+        axis: &'static str,
+        value: f64,
+        lo: f64,
+        hi: f64,
+    },
+    /// Two spheres of an initial file that overlap beyond the run guard's limit (`msg` names
+    /// them, their lines and the overlap).
+    #[error("{}:{line}: {msg}", path.display())]
+    Overlap {
+        path: PathBuf,
+        line: usize,
+        msg: String,
+    },
+    /// More spheres than the random fill's lattice holds between the walls (`d`: diameter).
+    #[error(
+        "cannot fit {n} spheres of diameter {d} between the walls (room for {room} on a lattice)"
+    )]
+    NoRoom { n: usize, d: f64, room: usize },
+    /// A tiling asked for no tiles.
+    #[error("tiles: nx and ny must be 1 or more, got {nx} × {ny}")]
+    NoTiles { nx: usize, ny: usize },
+    /// A state whose box is not periodic in x and y cannot be tiled.
+    #[error("tiles: the box must be periodic in x and y, got periodic = {periodic:?}")]
+    NotPeriodic { periodic: [bool; 3] },
+    /// A case that cannot be tiled: `field` of `file` says why.
+    #[error("{file}: {field}: {msg}")]
+    NotTileable {
+        file: String,
+        field: String,
+        msg: String,
+    },
+    /// A case file's text that is not TOML.
+    #[error("{file}")]
+    Toml {
+        file: String,
+        #[source]
+        source: toml::de::Error,
+    },
+    /// The tiled case's table could not be written as TOML.
+    #[error("a case table is written as TOML")]
+    TomlWrite(#[source] toml::ser::Error),
+    /// The tiled case is refused by the checks of a case file.
+    #[error("{file}: the tiled case is not valid")]
+    TiledInvalid {
+        file: String,
+        #[source]
+        source: CaseError,
+    },
+    /// The case of `path` whose state cannot be tiled (the source says why).
+    #[error("{}: cannot be tiled", path.display())]
+    CannotTile {
+        path: PathBuf,
+        #[source]
+        source: Box<SceneError>,
+    },
+    /// A folder that cannot be made.
+    #[error("{}: cannot create the folder", path.display())]
+    Folder {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file not written ([`crate::io::atomic::write`]'s error, which names it).
+    #[error(transparent)]
+    Write(std::io::Error),
+}
 
 /// The box of a case.
 pub fn domain_of(case: &Case) -> Domain {
@@ -27,7 +137,7 @@ pub fn domain_of(case: &Case) -> Domain {
 }
 
 /// Builds the initial scene of a case; `init` overrides the case's `run.init`.
-pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
+pub fn build(case: &Case, init: Option<&Path>) -> Result<Scene, SceneError> {
     let domain = domain_of(case);
     let d = case.material.diameter;
     let rho = case.material.density;
@@ -64,13 +174,12 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
             if let Some(path) = init_path {
                 let loaded = load_init(&path, &domain)?;
                 if loaded.x.len() != n_wall + free {
-                    bail!(
-                        "{}: has {} particles, the case expects {} wall + {} free",
-                        path.display(),
-                        loaded.x.len(),
-                        n_wall,
-                        free
-                    );
+                    return Err(SceneError::Count {
+                        path,
+                        found: loaded.x.len(),
+                        wall: n_wall,
+                        free: *free,
+                    });
                 }
                 time = loaded.time;
                 for a in 0..loaded.x.len() {
@@ -79,14 +188,13 @@ pub fn build(case: &Case, init: Option<&Path>) -> anyhow::Result<Scene> {
                             let v = Vec3::new(walls[g as usize].1, 0.0, 0.0);
                             if let Some(fv) = loaded.v.get(a) {
                                 if (fv - v).amax() > 1e-9 {
-                                    bail!(
-                                        "{}:{}: wall sphere {} moves at {:?}, the case prescribes {:?}",
-                                        path.display(),
-                                        loaded.line[a],
-                                        a + 1,
-                                        fv.as_slice(),
-                                        v.as_slice()
-                                    );
+                                    return Err(SceneError::WallMotion {
+                                        path,
+                                        line: loaded.line[a],
+                                        id: a + 1,
+                                        found: [fv.x, fv.y, fv.z],
+                                        prescribed: [v.x, v.y, v.z],
+                                    });
                                 }
                             }
                             particles.push(
@@ -203,7 +311,7 @@ struct Loaded {
 
 /// Reads an official initial file or a MercuryCG `.data` file (told apart by their first
 /// word, read line by line), checking its box against the case's.
-fn load_init(path: &Path, domain: &Domain) -> anyhow::Result<Loaded> {
+fn load_init(path: &Path, domain: &Domain) -> Result<Loaded, FormatError> {
     let mut lines = crate::io::open(path)?;
     let file = path.display().to_string();
     if official::looks_official(lines.peek()?) {
@@ -242,20 +350,19 @@ fn check_loaded(
     p: &Particles,
     domain: &Domain,
     overlap: f64,
-) -> anyhow::Result<()> {
-    let file = path.display();
+) -> Result<(), SceneError> {
     for a in 0..p.len() {
         if let Some(k) = (0..3).find(|&k| !(p.x[a][k] >= domain.lo[k] && p.x[a][k] <= domain.hi[k]))
         {
-            bail!(
-                "{file}:{}: particle {}: {} = {} is outside the case's box [{}, {}]",
-                line[a],
-                a + 1,
-                ["x", "y", "z"][k],
-                p.x[a][k],
-                domain.lo[k],
-                domain.hi[k]
-            );
+            return Err(SceneError::Outside {
+                path: path.to_path_buf(),
+                line: line[a],
+                id: a + 1,
+                axis: ["x", "y", "z"][k],
+                value: p.x[a][k],
+                lo: domain.lo[k],
+                hi: domain.hi[k],
+            });
         }
     }
     let free = |a: usize| matches!(p.motion[a], Motion::Free);
@@ -273,18 +380,21 @@ fn check_loaded(
             } else {
                 format!("overlap by {delta:e}")
             };
-            bail!(
-                "{file}:{}: particles {} ({}, line {}) and {} ({}, line {}) {what}, beyond the \
-                 limit {limit:e} ([guard] overlap = {overlap} times the smaller radius); the run \
-                 guard would stop the first step",
-                line[a.max(b)],
-                a + 1,
-                kind(a),
-                line[a],
-                b + 1,
-                kind(b),
-                line[b],
-            );
+            return Err(SceneError::Overlap {
+                path: path.to_path_buf(),
+                line: line[a.max(b)],
+                msg: format!(
+                    "particles {} ({}, line {}) and {} ({}, line {}) {what}, beyond the limit \
+                     {limit:e} ([guard] overlap = {overlap} times the smaller radius); the run \
+                     guard would stop the first step",
+                    a + 1,
+                    kind(a),
+                    line[a],
+                    b + 1,
+                    kind(b),
+                    line[b],
+                ),
+            });
         }
     }
     Ok(())
@@ -362,7 +472,7 @@ pub fn random_fill(
     d: f64,
     z_range: (f64, f64),
     seed: u64,
-) -> anyhow::Result<Vec<Vec3>> {
+) -> Result<Vec<Vec3>, SceneError> {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let l = domain.lengths();
     let spacing = d * 1.0001;
@@ -392,10 +502,11 @@ pub fn random_fill(
         }
     }
     if sites.len() < n {
-        bail!(
-            "cannot fit {n} spheres of diameter {d} between the walls (room for {} on a lattice)",
-            sites.len()
-        );
+        return Err(SceneError::NoRoom {
+            n,
+            d,
+            room: sites.len(),
+        });
     }
     sites.shuffle(&mut rng);
     sites.truncate(n);

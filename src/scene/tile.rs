@@ -9,8 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context};
-
+use super::SceneError;
 use crate::case::{Case, Scene as SceneSpec};
 use crate::contact::named;
 use crate::io::{atomic, mercury};
@@ -26,9 +25,14 @@ pub fn tiled_name(name: &str, nx: usize, ny: usize) -> String {
 /// multiplied, tile (i, j) shifted by (i Lx, j Ly, 0), ids as the module says. Every particle
 /// keeps its velocity, spin, radius and motion (its mass from `density`, mass/length³); contacts are not carried (a run re-finds them).
 /// The x and y axes of `s` must be periodic: the cell's periodic images become the tiles.
-pub fn tile_state(s: &Snapshot, density: f64, nx: usize, ny: usize) -> anyhow::Result<Snapshot> {
+pub fn tile_state(
+    s: &Snapshot,
+    density: f64,
+    nx: usize,
+    ny: usize,
+) -> Result<Snapshot, SceneError> {
     if nx == 0 || ny == 0 {
-        bail!("tiles: nx and ny must be 1 or more, got {nx} × {ny}");
+        return Err(SceneError::NoTiles { nx, ny });
     }
     let spheres = s.particles.len() as f64 * nx as f64 * ny as f64;
     // The tiled state, its `.data` text (~200 bytes a sphere) and the run that follows.
@@ -40,10 +44,9 @@ pub fn tile_state(s: &Snapshot, density: f64, nx: usize, ny: usize) -> anyhow::R
         spheres * (crate::state::memory::BYTES_PER_SPHERE + 200.0),
     )?;
     if !(s.domain.periodic[0] && s.domain.periodic[1]) {
-        bail!(
-            "tiles: the box must be periodic in x and y, got periodic = {:?}",
-            s.domain.periodic
-        );
+        return Err(SceneError::NotPeriodic {
+            periodic: s.domain.periodic,
+        });
     }
     let l = s.domain.lengths();
     let lo = s.domain.lo;
@@ -100,7 +103,7 @@ pub fn tile_case_text(
     nx: usize,
     ny: usize,
     init: &str,
-) -> anyhow::Result<String> {
+) -> Result<String, SceneError> {
     let case = Case::parse(text, file)?;
     let SceneSpec::BumpyShear {
         free,
@@ -109,20 +112,31 @@ pub fn tile_case_text(
         ..
     } = case.scene
     else {
-        bail!("{file}: scene.kind: tiles are made of bumpy-shear cases");
+        return Err(not_tileable(
+            file,
+            "scene.kind",
+            "tiles are made of bumpy-shear cases".into(),
+        ));
     };
     if wall_rows % 2 != 0 && ny > 1 {
-        bail!(
-            "{file}: scene.wall_rows: an even number of rows continues the hexagonal walls \
-             across tiles in y, got {wall_rows}"
-        );
+        return Err(not_tileable(
+            file,
+            "scene.wall_rows",
+            format!(
+                "an even number of rows continues the hexagonal walls across tiles in y, got \
+                 {wall_rows}"
+            ),
+        ));
     }
-    let mut t: toml::Table = toml::from_str(text).with_context(|| file.to_string())?;
-    let table = |t: &mut toml::Table, key: &str| -> anyhow::Result<toml::Table> {
+    let mut t: toml::Table = toml::from_str(text).map_err(|source| SceneError::Toml {
+        file: file.to_string(),
+        source,
+    })?;
+    let table = |t: &mut toml::Table, key: &str| -> Result<toml::Table, SceneError> {
         match t.remove(key) {
             Some(toml::Value::Table(x)) => Ok(x),
             None => Ok(toml::Table::new()),
-            Some(_) => bail!("{file}: {key}: a table expected"),
+            Some(_) => Err(not_tileable(file, key, "a table expected".into())),
         }
     };
     let (lo, hi) = (case.domain.lo, case.domain.hi);
@@ -153,10 +167,22 @@ pub fn tile_case_text(
     t.insert("run".into(), toml::Value::Table(run));
     t.insert("domain".into(), toml::Value::Table(domain));
     t.insert("scene".into(), toml::Value::Table(scene));
-    let body = toml::to_string(&t).context("a case table is written as TOML")?;
+    let body = toml::to_string(&t).map_err(SceneError::TomlWrite)?;
     let out = format!("# {file} tiled {nx} × {ny} in x–y by `verdem tile`; state {init}\n{body}");
-    Case::parse(&out, file).with_context(|| format!("{file}: the tiled case is not valid"))?;
+    Case::parse(&out, file).map_err(|source| SceneError::TiledInvalid {
+        file: file.to_string(),
+        source,
+    })?;
     Ok(out)
+}
+
+/// The error of a case `file` that cannot be tiled: its `field` and why.
+fn not_tileable(file: &str, field: &str, msg: String) -> SceneError {
+    SceneError::NotTileable {
+        file: file.to_string(),
+        field: field.to_string(),
+        msg,
+    }
 }
 
 /// Writes the case `case_path` tiled `nx` × `ny` from the state file `from` (a MercuryCG `.data`
@@ -168,7 +194,7 @@ pub fn write(
     nx: usize,
     ny: usize,
     out: &Path,
-) -> anyhow::Result<(PathBuf, PathBuf)> {
+) -> Result<(PathBuf, PathBuf), SceneError> {
     let case = named::load(case_path)?;
     let (_, text) = crate::io::read_text(case_path)?;
     let name = tiled_name(&case.name, nx, ny);
@@ -182,12 +208,18 @@ pub fn write(
         particles: scene.particles,
         contacts: Vec::new(),
     };
-    let tiled = tile_state(&cell, case.material.density, nx, ny)
-        .with_context(|| format!("{}: cannot be tiled", case_path.display()))?;
-    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
+    let tiled =
+        tile_state(&cell, case.material.density, nx, ny).map_err(|e| SceneError::CannotTile {
+            path: case_path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+    std::fs::create_dir_all(out).map_err(|source| SceneError::Folder {
+        path: out.to_path_buf(),
+        source,
+    })?;
     let (case_out, data_out) = (out.join(format!("{name}.toml")), out.join(&data));
-    atomic::write(&data_out, mercury::data_text(&tiled).as_bytes())?;
-    atomic::write(&case_out, case_text.as_bytes())?;
+    atomic::write(&data_out, mercury::data_text(&tiled).as_bytes()).map_err(SceneError::Write)?;
+    atomic::write(&case_out, case_text.as_bytes()).map_err(SceneError::Write)?;
     Ok((case_out, data_out))
 }
 
