@@ -23,6 +23,7 @@ mod output;
 mod run;
 mod scene;
 mod time_step;
+mod walls;
 
 pub use contact::{Contact, Convention};
 pub use domain::DomainSpec;
@@ -34,6 +35,7 @@ pub use output::Output;
 pub use run::Run;
 pub use scene::{Scene, SphereSpec};
 pub use time_step::COARSE_STEPS_PER_COLLISION;
+pub use walls::WallSpec;
 
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
@@ -62,6 +64,9 @@ pub struct Case {
     pub guard: Guard,
     #[serde(default)]
     pub output: Output,
+    /// Flat walls (`[[wall]]`), none by default.
+    #[serde(default)]
+    pub wall: Vec<WallSpec>,
     /// Directory the case was read from (relative paths in the case resolve against it).
     #[serde(skip)]
     pub dir: PathBuf,

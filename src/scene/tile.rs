@@ -86,6 +86,8 @@ pub fn tile_state(s: &Snapshot, density: f64, nx: usize, ny: usize) -> anyhow::R
         domain: Domain::new(lo, hi, s.domain.periodic),
         particles: out,
         contacts: Vec::new(),
+        walls: Vec::new(),
+        wall_contacts: Vec::new(),
     })
 }
 
@@ -181,6 +183,8 @@ pub fn write(
         domain: scene.domain,
         particles: scene.particles,
         contacts: Vec::new(),
+        walls: Vec::new(),
+        wall_contacts: Vec::new(),
     };
     let tiled = tile_state(&cell, case.material.density, nx, ny)
         .with_context(|| format!("{}: cannot be tiled", case_path.display()))?;
@@ -228,6 +232,8 @@ mod tests {
             domain: Domain::new(z, Vec3::new(2.0, 3.0, 6.0), [true, true, false]),
             particles: p,
             contacts: Vec::new(),
+            walls: Vec::new(),
+            wall_contacts: Vec::new(),
         }
     }
 
