@@ -151,3 +151,24 @@ fn wall_contacts_resume_bit_for_bit_on_one_and_two_threads() {
     let with = verdem::io::hash::state_hash(&half);
     assert_ne!(verdem::io::hash::state_hash(&bare), with);
 }
+
+/// `verdem verify`'s plane rows: every one passes and gates, head-on, oblique and rolling for
+/// every tangential convention; the recurrence rows hold the plane to the scheme's own
+/// free–wall numbers at round-off.
+#[test]
+fn the_plane_rows_pass() {
+    let case = wall_case();
+    let rows = verdem::verify::walls::rows(&case).unwrap();
+    let conventions = verdem::contact::Tangential::ALL.len();
+    // 3 speeds × 6 quantities, the order, 2 oblique and 4 rolling rows per convention
+    assert_eq!(rows.len(), 19 + 6 * conventions);
+    for r in &rows {
+        assert!(r.passed(), "{r:?}");
+    }
+    assert!(
+        rows.iter()
+            .filter(|r| r.case.contains("recurrence"))
+            .count()
+            == 9
+    );
+}
