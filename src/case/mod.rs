@@ -2,7 +2,8 @@
 //! restitution, time step). Every error names the file, the line and the field.
 //!
 //! One file per section of the case file, each section's struct beside the checks of its
-//! fields (`run`, `neighbor`, `guard`, `output`, `domain`, `material`, `contact`, `scene`);
+//! fields (`run`, `neighbor`, `guard`, `output`, `domain`, `material`, `contact`, `scene`,
+//! `walls` for the `[[wall]]` tables);
 //! reading and the order of the checks in `load`, where errors point in `locate`, the
 //! quantities derived from the parameters in `derived`, and the time step against the scheme's
 //! stability limit in `time_step`.
