@@ -136,6 +136,7 @@ impl Case {
             ));
         }
         self.check_scene(at)?;
+        self.check_walls(at)?;
         match purpose {
             Purpose::Run => self.check_time_step(at),
             Purpose::PrescribedMotion => Ok(Vec::new()),

@@ -2,7 +2,8 @@
 //! restitution, time step). Every error names the file, the line and the field.
 //!
 //! One file per section of the case file, each section's struct beside the checks of its
-//! fields (`run`, `neighbor`, `guard`, `output`, `domain`, `material`, `contact`, `scene`);
+//! fields (`run`, `neighbor`, `guard`, `output`, `domain`, `material`, `contact`, `scene`,
+//! `walls` for the `[[wall]]` tables);
 //! reading and the order of the checks in `load`, where errors point in `locate`, the
 //! quantities derived from the parameters in `derived`, and the time step against the scheme's
 //! stability limit in `time_step`.
@@ -23,6 +24,7 @@ mod output;
 mod run;
 mod scene;
 mod time_step;
+mod walls;
 
 pub use contact::{Contact, Convention};
 pub use domain::DomainSpec;
@@ -34,6 +36,7 @@ pub use output::Output;
 pub use run::Run;
 pub use scene::{Scene, SphereSpec};
 pub use time_step::COARSE_STEPS_PER_COLLISION;
+pub use walls::WallSpec;
 
 /// An error in a case file: `file:line: field: message`.
 #[derive(Debug, thiserror::Error)]
@@ -62,6 +65,9 @@ pub struct Case {
     pub guard: Guard,
     #[serde(default)]
     pub output: Output,
+    /// Flat walls (`[[wall]]`), none by default.
+    #[serde(default)]
+    pub wall: Vec<WallSpec>,
     /// Directory the case was read from (relative paths in the case resolve against it).
     #[serde(skip)]
     pub dir: PathBuf,

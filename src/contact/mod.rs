@@ -13,6 +13,7 @@ pub mod named;
 pub mod normal;
 pub mod normal_laws;
 pub mod parameters;
+pub mod plane;
 pub mod registry;
 pub mod tangential;
 
@@ -55,9 +56,29 @@ pub struct PairKinematics {
     /// Radii of P and I (length).
     pub rad_p: f64,
     pub rad_i: f64,
+    /// Inverse masses of P and I (1/mass; 0 for a fixed sphere or a wall).
+    pub inv_mass_p: f64,
+    pub inv_mass_i: f64,
     /// Angular velocities of P and I (1/time).
     pub w_p: Vec3,
     pub w_i: Vec3,
+}
+
+impl PairKinematics {
+    /// Effective radius R* = r_P·r_I/(r_P + r_I) (length); r_P for a plane (r_I infinite).
+    #[inline(always)]
+    pub fn r_star(&self) -> f64 {
+        if self.rad_i.is_infinite() {
+            self.rad_p
+        } else {
+            self.rad_p * self.rad_i / (self.rad_p + self.rad_i)
+        }
+    }
+    /// Effective mass m* = 1/(1/m_P + 1/m_I) (mass); m_P for a fixed partner (1/m_I = 0).
+    #[inline(always)]
+    pub fn m_star(&self) -> f64 {
+        1.0 / (self.inv_mass_p + self.inv_mass_i)
+    }
 }
 
 /// Everything known about the two spheres of a candidate pair.
@@ -68,6 +89,9 @@ pub struct PairInput {
     /// Radii of P and I.
     pub rad_p: f64,
     pub rad_i: f64,
+    /// Inverse masses of P and I (1/mass; 0 for a fixed sphere or a wall).
+    pub inv_mass_p: f64,
+    pub inv_mass_i: f64,
     /// Velocities of P and I (the half-step velocities during a time step).
     pub v_p: Vec3,
     pub v_i: Vec3,
@@ -85,6 +109,8 @@ impl PairInput {
             r,
             rad_p,
             rad_i,
+            inv_mass_p: 0.0,
+            inv_mass_i: 0.0,
             v_p: Vec3::zeros(),
             v_i: Vec3::zeros(),
             w_p: Vec3::zeros(),
@@ -124,6 +150,8 @@ impl PairInput {
             r: self.r,
             rad_p: self.rad_p,
             rad_i: self.rad_i,
+            inv_mass_p: self.inv_mass_p,
+            inv_mass_i: self.inv_mass_i,
             w_p: self.w_p,
             w_i: self.w_i,
         })

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 
 use crate::contact::PairForce;
-use crate::state::{Contact, Snapshot};
+use crate::state::{Contact, Snapshot, WallContact};
 use crate::step::{Engine, Flows, Reading};
 use crate::Vec3;
 
@@ -203,11 +203,16 @@ impl CheckpointError {
 /// differ; the particle count, the time step and the number of history words are stored and
 /// compared apart.
 pub fn tag(case: &crate::case::Case) -> String {
-    format!(
+    let mut tag = format!(
         "case={:?}\ntangential={}",
         case.name,
         case.contact.tangential.name()
-    )
+    );
+    // the flat walls' count, only when there are walls (checkpoints without stay as they were)
+    if !case.wall.is_empty() {
+        tag.push_str(&format!("\nwalls={}", case.wall.len()));
+    }
+    tag
 }
 
 /// Writes a checkpoint of a state advanced with time step `dt` without a run record (its
@@ -221,7 +226,8 @@ pub fn write(path: &Path, core: &Snapshot, dt: f64, tag: &str) -> Result<(), Che
 /// `tag` identifies the case (checked on resume; see [`tag`]). Layout (little-endian): magic,
 /// format version, tag, step, time, dt, particle count, history words per contact, then x v w
 /// f t of every particle, the contact count and each contact (p, i as u32, its history words,
-/// f, torques, fn); then the run record: a flag (0 or 1) and the ledgers (the flows, a flag and
+/// f, torques, fn); when the scene has flat walls, their section ([`put_walls`]); then the run
+/// record: a flag (0 or 1) and the ledgers (the flows, a flag and
 /// the reading at the last save: [`put_flows`], [`put_reading`]), a flag and the observer's
 /// state (its length and bytes); last the SHA-256 digest of all the bytes before it (32 bytes).
 pub fn write_run(
@@ -241,7 +247,9 @@ pub fn write_run(
     b.extend_from_slice(&dt.to_le_bytes());
     let p = &core.particles;
     b.extend_from_slice(&(p.len() as u64).to_le_bytes());
-    let words = core.contacts.first().map_or(0, |c| c.history.len());
+    let words = (core.contacts.first().map(|c| c.history.len()))
+        .or(core.wall_contacts.first().map(|c| c.history.len()))
+        .unwrap_or(0);
     b.extend_from_slice(&(words as u64).to_le_bytes());
     let put = |b: &mut Vec<u8>, v: &Vec3| {
         for k in 0..3 {
@@ -271,6 +279,9 @@ pub fn write_run(
         }
         b.extend_from_slice(&o.fn_signed.to_le_bytes());
     }
+    if !core.walls.is_empty() {
+        put_walls(&mut b, core, words);
+    }
     let flag = |b: &mut Vec<u8>, set: bool| b.extend_from_slice(&u64::from(set).to_le_bytes());
     flag(&mut b, record.ledgers.is_some());
     if let Some(l) = &record.ledgers {
@@ -288,6 +299,86 @@ pub fn write_run(
     let sum = Sha256::digest(&b);
     b.extend_from_slice(&sum);
     crate::io::atomic::write(path, &b).map_err(CheckpointError::Write)
+}
+
+/// Appends the flat walls' section: each wall's point (3 f64), the wall contacts' count and each
+/// wall contact (sphere and wall as u32, its `words` history words, force, torque on the sphere
+/// and fn).
+fn put_walls(b: &mut Vec<u8>, core: &Snapshot, words: usize) {
+    let put = |b: &mut Vec<u8>, v: &Vec3| {
+        for k in 0..3 {
+            b.extend_from_slice(&v[k].to_le_bytes());
+        }
+    };
+    for w in &core.walls {
+        put(b, &w.point);
+    }
+    b.extend_from_slice(&(core.wall_contacts.len() as u64).to_le_bytes());
+    for c in &core.wall_contacts {
+        b.extend_from_slice(&c.particle.to_le_bytes());
+        b.extend_from_slice(&c.wall.to_le_bytes());
+        for k in 0..words {
+            let w = c.history.get(k).copied().unwrap_or(0.0);
+            b.extend_from_slice(&w.to_le_bytes());
+        }
+        put(b, &c.force.f);
+        put(b, &c.force.torque_p);
+        b.extend_from_slice(&c.force.fn_signed.to_le_bytes());
+    }
+}
+
+/// Reads the flat walls' section ([`put_walls`]) into `snap`, whose walls are the case's
+/// (their count), for a law of `words` history words and `particles` spheres.
+fn read_walls(
+    r: &mut Reader<'_>,
+    snap: &mut Snapshot,
+    words: usize,
+    particles: usize,
+) -> Result<(), CheckpointError> {
+    for (w, wall) in snap.walls.iter_mut().enumerate() {
+        wall.point = r.vec(&|| format!("wall[{w}]: point"))?;
+    }
+    let at = r.at();
+    // sphere and wall, the history words, f, the torque and fn (bytes)
+    let len = 8 + 8 * words + 8 * 7;
+    let contacts = r.count((r.b.len() - r.at) / len, &|| {
+        format!("byte {at}: the wall contact count")
+    })?;
+    snap.wall_contacts.clear();
+    for c in 0..contacts {
+        let at = r.at();
+        let (particle, wall) = (r.u32()?, r.u32()?);
+        if particle as usize >= particles || wall as usize >= snap.walls.len() {
+            return Err(r.error(
+                at,
+                format!(
+                    "wall contact {c} of particle {particle} with wall {wall} (0-based): not \
+                     one of the case's {particles} spheres and {} walls",
+                    snap.walls.len()
+                ),
+            ));
+        }
+        let what = |q: &'static str| move || format!("wall contact {c}: {q}");
+        let history = (0..words)
+            .map(|_| r.f64(&what("history")))
+            .collect::<Result<Vec<f64>, CheckpointError>>()?;
+        let f = r.vec(&what("force"))?;
+        let torque_p = r.vec(&what("torque"))?;
+        let fn_signed = r.f64(&what("normal force"))?;
+        snap.wall_contacts.push(WallContact {
+            particle,
+            wall,
+            history,
+            spring: Vec3::zeros(),
+            force: PairForce {
+                f,
+                fn_signed,
+                torque_p,
+                torque_i: Vec3::zeros(),
+            },
+        });
+    }
+    Ok(())
 }
 
 /// The first 8 bytes of `digest` in hex, as messages show a checksum.
@@ -678,6 +769,9 @@ pub fn restore_run(
                 torque_i,
             },
         });
+    }
+    if !snap.walls.is_empty() {
+        read_walls(&mut r, &mut snap, case_words, particles)?;
     }
     let mut record = RunRecord::default();
     let mut observer_at = body.len();

@@ -1,7 +1,9 @@
 //! SHA-256 of the full dynamic state, serialised canonically: little-endian f64 of positions,
 //! velocities and angular velocities of every particle in id order, then for every contact with
 //! a tangential history, sorted by index pair, `P I` as little-endian u32 and the words of its
-//! history as f64 (ξ for every law today).
+//! history as f64 (ξ for every law today); then, only when the scene has flat walls, each
+//! wall's point (f64) and each wall contact, sorted by (sphere, wall), sphere and wall as u32
+//! and its history words (a scene without walls hashes as before they existed).
 
 use sha2::{Digest, Sha256};
 
@@ -21,6 +23,18 @@ pub fn state_hash(core: &Snapshot) -> String {
     for c in &core.contacts {
         h.update(c.p.to_le_bytes());
         h.update(c.i.to_le_bytes());
+        for w in &c.history {
+            h.update(w.to_le_bytes());
+        }
+    }
+    for w in &core.walls {
+        for k in 0..3 {
+            h.update(w.point[k].to_le_bytes());
+        }
+    }
+    for c in &core.wall_contacts {
+        h.update(c.particle.to_le_bytes());
+        h.update(c.wall.to_le_bytes());
         for w in &c.history {
             h.update(w.to_le_bytes());
         }

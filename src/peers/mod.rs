@@ -652,6 +652,8 @@ mod tests {
             domain: Domain::new(Vec3::zeros(), Vec3::new(4.0, 4.0, 4.0), [false; 3]),
             particles: p,
             contacts: Vec::new(),
+            walls: Vec::new(),
+            wall_contacts: Vec::new(),
         };
         let on_p = [Vec3::new(-3.0, 0.25, 0.0), Vec3::new(-1.0, 0.0, 0.5)];
         s.contacts = [(0, 1), (1, 2)]

@@ -261,6 +261,8 @@ pub fn drive(
         domain: scene.domain,
         particles: scene.particles,
         contacts: Vec::new(),
+        walls: Vec::new(),
+        wall_contacts: Vec::new(),
     };
     let api = library::api(peer.flavour())?;
     let dir = TempDir::new()?;

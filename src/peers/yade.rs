@@ -478,6 +478,8 @@ mod tests {
             domain: Domain::new(Vec3::repeat(-5.0), Vec3::repeat(5.0), [false; 3]),
             particles,
             contacts: Vec::new(),
+            walls: Vec::new(),
+            wall_contacts: Vec::new(),
         }
     }
 

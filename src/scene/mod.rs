@@ -281,6 +281,7 @@ pub fn build(case: &Case, init: Option<&Path>) -> Result<Scene, SceneError> {
         domain,
         particles,
         time,
+        walls: walls_of(case),
     })
 }
 
@@ -623,6 +624,19 @@ impl HardSphereGrid {
         self.cells[c0].swap_remove(pos);
         self.cells[c1].push((true, a, *to));
     }
+}
+
+/// The flat walls of `case` at the start (`[[wall]]`): unit normals, points and velocities
+/// as given.
+pub fn walls_of(case: &Case) -> Vec<crate::state::Wall> {
+    case.wall
+        .iter()
+        .map(|w| crate::state::Wall {
+            point: Vec3::from(w.point),
+            normal: Vec3::from(w.unit_normal()),
+            velocity: Vec3::from(w.velocity),
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -89,6 +89,8 @@ pub fn tile_state(
         domain: Domain::new(lo, hi, s.domain.periodic),
         particles: out,
         contacts: Vec::new(),
+        walls: Vec::new(),
+        wall_contacts: Vec::new(),
     })
 }
 
@@ -207,6 +209,8 @@ pub fn write(
         domain: scene.domain,
         particles: scene.particles,
         contacts: Vec::new(),
+        walls: Vec::new(),
+        wall_contacts: Vec::new(),
     };
     let tiled =
         tile_state(&cell, case.material.density, nx, ny).map_err(|e| SceneError::CannotTile {
@@ -260,6 +264,8 @@ mod tests {
             domain: Domain::new(z, Vec3::new(2.0, 3.0, 6.0), [true, true, false]),
             particles: p,
             contacts: Vec::new(),
+            walls: Vec::new(),
+            wall_contacts: Vec::new(),
         }
     }
 

@@ -5,11 +5,13 @@ pub mod history;
 pub mod memory;
 pub mod snapshot;
 pub mod tally;
+pub mod walls;
 
 pub use domain::Domain;
 pub use history::History;
 pub use snapshot::{Contact, PairForce, SampledContact, Snapshot};
 pub use tally::Tally;
+pub use walls::{Wall, WallContact};
 
 use crate::Vec3;
 

@@ -38,6 +38,10 @@ pub struct Snapshot {
     pub domain: Domain,
     pub particles: Particles,
     pub contacts: Vec<Contact>,
+    /// The flat walls where they are at this step (none for most scenes).
+    pub walls: Vec<super::Wall>,
+    /// The spheres' contacts with them, sorted by (sphere, wall).
+    pub wall_contacts: Vec<super::WallContact>,
 }
 
 /// A contact as a sample of the contact stress needs it: the original indices `p < i`, the

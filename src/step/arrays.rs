@@ -36,6 +36,8 @@ pub(super) struct Arrays<H> {
     pub near_face: SharedSlice<bool>,
     pub quiet: SharedSlice<bool>,
     pub kind: SharedSlice<u8>,
+    /// Original index of each particle (the wall contacts' slots are by it).
+    pub id: SharedSlice<u32>,
     pub p: SharedSlice<u32>,
     pub i: SharedSlice<u32>,
     pub adj_start: SharedSlice<u32>,
@@ -82,6 +84,7 @@ impl<H> Arrays<H> {
             near_face: SharedSlice::of(&mut flags.near_face),
             quiet: SharedSlice::of(&mut flags.quiet),
             kind: SharedSlice::of(&mut flags.kind),
+            id: SharedSlice::of(l.id),
             p: SharedSlice::of(&mut pairs.list.p),
             i: SharedSlice::of(&mut pairs.list.i),
             adj_start: SharedSlice::of(&mut pairs.list.adj_start),

@@ -8,10 +8,13 @@ use std::sync::Arc;
 use super::counters::StageTimes;
 use super::guard::Failure;
 use crate::case::Guard;
-use crate::state::{Contact, Domain, History, PairForce, Particles, SampledContact, Snapshot};
+use crate::state::{
+    Contact, Domain, History, PairForce, Particles, SampledContact, Snapshot, Wall,
+};
 use crate::step::neighbor::rebuild::{self, key, Flags, ListState, Pairs, Plan};
 use crate::step::neighbor::NeighborBuilder;
 use crate::step::team::{Crew, Shared};
+use crate::step::walls::WallSlots;
 use crate::Vec3;
 
 /// The dynamic state. Particle arrays are in memory order (re-ordered by cell at every pair-list
@@ -74,6 +77,8 @@ pub struct Core<H> {
     pub state: State,
     /// Candidate pairs with their contact history and last forces.
     pub pairs: Pairs<H>,
+    /// The flat walls and their contacts with the spheres.
+    pub walls: WallSlots<H>,
     pub params: Params,
     pub counters: StageTimes,
     /// Why the run guard stopped the last run, if it did; the state is then not to be trusted
@@ -133,6 +138,7 @@ impl<H: History> Core<H> {
                 forces_ready: false,
             },
             pairs: Pairs::default(),
+            walls: WallSlots::new(Vec::new(), 0),
             params: Params {
                 dt,
                 gravity,
@@ -157,6 +163,13 @@ impl<H: History> Core<H> {
             energy_at: None,
             contact_samples: Vec::new(),
         }
+    }
+
+    /// Sets the flat walls of the scene (where they are now), with no contact yet.
+    pub fn set_walls(&mut self, walls: Vec<Wall>) {
+        self.walls = WallSlots::new(walls, self.state.particles.len());
+        self.state.forces_ready = false;
+        self.energy_at = None;
     }
 
     /// Skin of the pair list (length).
@@ -272,6 +285,8 @@ impl<H: History> Core<H> {
             domain: s.domain.clone(),
             particles,
             contacts,
+            walls: self.walls.walls.clone(),
+            wall_contacts: self.walls.contacts(),
         }
     }
 
@@ -283,6 +298,12 @@ impl<H: History> Core<H> {
         self.state.particles = snap.particles.clone();
         self.state.step = snap.step;
         self.state.time = snap.time;
+        assert_eq!(
+            self.walls.walls.len(),
+            snap.walls.len(),
+            "snapshot of another scene's walls"
+        );
+        self.walls.restore(&snap.walls, &snap.wall_contacts);
         self.restore_contacts(&snap.contacts);
     }
 }

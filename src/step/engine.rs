@@ -150,6 +150,8 @@ pub struct Scene {
     pub particles: Particles,
     /// Start time (that of the `.data` file it was read from, else 0).
     pub time: f64,
+    /// The flat walls (`[[wall]]`) at the start.
+    pub walls: Vec<crate::state::Wall>,
 }
 
 /// Overrides of the case's numerical settings (command line).
@@ -256,6 +258,7 @@ impl LawVisitor for BuildSimulation {
             self.threads,
         );
         core.state.time = self.scene.time;
+        core.set_walls(self.scene.walls);
         core.params.bind = self.bind;
         core.params.guard = self.guard;
         Box::new(Simulation::new(law, core))

@@ -422,6 +422,8 @@ unsafe fn evaluate<L: ContactLaw>(
         r,
         rad_p: view.radius[p],
         rad_i: view.radius[i],
+        inv_mass_p: view.inv_mass[p],
+        inv_mass_i: view.inv_mass[i],
         v_p: view.v.get(p),
         v_i: view.v.get(i),
         w_p: view.w.get(p),

@@ -39,6 +39,16 @@ pub(super) enum Breach {
         taken: f64,
         limit: f64,
     },
+    /// A force or torque of the contact of particle `particle` with flat wall `wall` (0-based)
+    /// that is not finite.
+    WallForce { particle: usize, wall: usize },
+    /// An overlap `delta` (length) of particle `particle` with flat wall `wall` beyond `limit`.
+    WallOverlap {
+        particle: usize,
+        wall: usize,
+        delta: f64,
+        limit: f64,
+    },
     /// A position outside the box along walled axis `axis` (0, 1, 2), or not finite.
     Outside {
         particle: usize,
@@ -154,6 +164,24 @@ impl Breach {
                 format!(
                     "overlap {delta:e} exceeds the limit {limit:e} (guard.overlap times the \
                      smaller radius)"
+                ),
+                UNSTABLE,
+            ),
+            Breach::WallForce { particle, wall } => (
+                vec![particle],
+                format!("the force or torque of its contact with wall[{wall}] is not finite"),
+                "an unstable step: use a smaller time step",
+            ),
+            Breach::WallOverlap {
+                particle,
+                wall,
+                delta,
+                limit,
+            } => (
+                vec![particle],
+                format!(
+                    "overlap {delta:e} with wall[{wall}] exceeds the limit {limit:e} \
+                     (guard.overlap times its radius): it is going through the wall"
                 ),
                 UNSTABLE,
             ),

@@ -5,6 +5,7 @@
 use std::sync::atomic::Ordering;
 
 use super::arrays::Arrays;
+use super::walls::WallViews;
 use crate::state::Domain;
 use crate::Vec3;
 
@@ -34,12 +35,13 @@ pub(super) struct Kick<'a> {
 ///
 /// # Safety
 /// `arr` is valid (taken after the last rebuild); no other thread touches particles `a..b`
-/// during the call; with `kick_end`, every pair chunk holding a pair of these particles is done
-/// and no thread writes those pairs' slots or these particles' `touched` flags.
+/// during the call; with `kick_end`, every pair chunk holding a pair of these particles is done,
+/// so is their wall chunk, and no thread writes those pairs' slots, these particles' wall slots
+/// (`walls`) or their `touched` flags.
 #[inline(never)]
 pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
     k: &Kick<'_>,
-    arr: &Arrays<H>,
+    (arr, walls): (&Arrays<H>, &WallViews<H>),
     a: usize,
     b: usize,
     kick_end: bool,
@@ -85,7 +87,11 @@ pub(super) unsafe fn particle_pass<H, const ROT: bool, const GRAV: bool>(
         let (fp, tp) = if kick_end {
             let g = if contact {
                 touched[j].store(false, Ordering::Relaxed);
-                gather(a + j, arr)
+                let (mut f, mut t) = gather(a + j, arr);
+                if walls.count > 0 {
+                    walls.add_to(arr.id.get(a + j), &mut f, &mut t);
+                }
+                (f, t)
             } else {
                 (Vec3::zeros(), Vec3::zeros())
             };

@@ -9,13 +9,16 @@
 //!    can have come closer than r_P + r_I unlisted;
 //! 3. pair forces at the new positions with the half-step velocities, each pair into its own
 //!    slot (its tangential history updated in place);
-//! 4. gather: each particle sums its slots in the order of its partners' ids; kick:
+//! 4. wall contacts: every free sphere against every flat wall, each contact into its own slot
+//!    ([`walls`]; nothing when the case has none);
+//! 5. gather: each particle sums its slots in the order of its partners' ids, then its wall
+//!    slots in the walls' order; kick:
 //!    v += (F/m + g)·dt/2, ω += T/I·dt/2; t += dt (a running sum).
 //!
 //! On a step the run samples ([`Params::contact_every`]), thread 0 reads the active contacts
-//! between 3 and 4 while the other threads wait; nothing is written.
+//! between 4 and 5 while the other threads wait; nothing is written.
 //!
-//! Steps 4 of one step and 1 of the next touch only one particle each, so they run fused in one
+//! Steps 5 of one step and 1 of the next touch only one particle each, so they run fused in one
 //! pass ([`integrate`]). With T threads every thread runs [`Worker::run`], the stages above by
 //! name; each pass is cut into chunks (contiguous particles, contiguous pairs) that the threads
 //! take from a [`WorkQueue`], their own share first and then what is left of the others'. The
@@ -37,6 +40,7 @@ pub mod guard;
 mod integrate;
 pub mod neighbor;
 pub mod team;
+pub mod walls;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -48,8 +52,9 @@ pub use self::engine::Engine;
 use self::forces::{book_dropped, contact_breach, pair_chunk, pair_force, PairView};
 use self::guard::{Alarm, Failure};
 use self::integrate::{gather, particle_pass, Kick};
+use self::walls::{wall_chunk, WallViews};
 use crate::contact::ContactLaw;
-use crate::state::{Domain, SampledContact};
+use crate::state::{Domain, SampledContact, Wall};
 use crate::step::neighbor::rebuild::{self, gap_closed, ListState, CLASSES};
 use crate::step::team::{Bound, Crew, Marks, Shared, SpinBarrier, WorkQueue};
 use crate::Vec3;
@@ -120,13 +125,19 @@ impl<L: ContactLaw> Simulation<L> {
     fn energy(&self) -> energy::Energy {
         let c = &self.core;
         let s = &c.state;
-        energy::measure(
+        let mut e = energy::measure(
             &self.law,
             &s.particles,
             &s.domain,
             c.params.gravity,
             &c.pairs,
-        )
+        );
+        if !c.walls.walls.is_empty() {
+            let pt = &s.particles;
+            let held = c.walls.stored(&self.law, &pt.x, &pt.radius, &s.id);
+            e.stored += energy::float(held);
+        }
+        e
     }
 
     /// The run guard's energy balance of the `steps` steps just run, from `before` to `after`
@@ -214,8 +225,21 @@ impl<L: ContactLaw> Simulation<L> {
                     self.core.failure = Some(b.report(state.step, state.time, &state.id));
                 }
             }
+            let views = WallViews::of(&mut self.core.walls);
+            let walls = self.core.walls.walls.clone();
+            if !walls.is_empty() {
+                let overlap = self.core.params.guard.overlap;
+                let watch = wall_chunk(&self.law, &walls, &views, &arr, (0, n), dt, overlap);
+                if let (Some(b), None) = (watch.breach, &self.core.failure) {
+                    let state = &self.core.state;
+                    self.core.failure = Some(b.report(state.step, state.time, &state.id));
+                }
+            }
             for a in 0..n {
-                let (f, t) = gather(a, &arr);
+                let (mut f, mut t) = gather(a, &arr);
+                if views.count > 0 {
+                    views.add_to(arr.id.get(a), &mut f, &mut t);
+                }
                 *arr.f.at_mut(a) = f;
                 *arr.t.at_mut(a) = t;
             }
@@ -257,6 +281,7 @@ impl<L: ContactLaw> Simulation<L> {
         core.deepest = core.deepest.max(done.deepest);
         core.pumped = core.pumped.max(done.pumped);
         core.contact_samples.extend(done.samples);
+        core.walls.walls = done.walls;
         for _ in 0..done.steps {
             core.state.time += dt;
         }
@@ -289,6 +314,8 @@ struct Done {
     deepest: f64,
     pumped: f64,
     samples: Vec<(u64, Vec<SampledContact>)>,
+    /// The flat walls where this thread's drifts left them (every thread's are the same).
+    walls: Vec<Wall>,
 }
 
 impl Done {
@@ -315,6 +342,12 @@ struct Team<'a, L: ContactLaw> {
     pair_queue: WorkQueue,
     /// Each pair chunk's last step done, for the gathers that wait for it.
     pairs_done: Marks,
+    /// The wall stage's particle chunks, and each one's last step done.
+    wall_queue: WorkQueue,
+    walls_done: Marks,
+    /// The flat walls at the run's start and the views of their contact slots.
+    walls: Vec<Wall>,
+    wall_views: WallViews<L::History>,
     rebuild_queue: WorkQueue,
     list: Shared<ListState<'a, L::History>>,
     arrays: Shared<Arrays<L::History>>,
@@ -350,6 +383,8 @@ impl<'a, L: ContactLaw> Team<'a, L> {
             .gravity
             .map(|g| energy::periodic_part(g, domain))
             .filter(|g| *g != Vec3::zeros());
+        let walls = core.walls.walls.clone();
+        let wall_views = WallViews::of(&mut core.walls);
         let mut list = core.list_state();
         let arrays = Shared::new(Arrays::of(&mut list));
         Team {
@@ -362,6 +397,10 @@ impl<'a, L: ContactLaw> Team<'a, L> {
             particle_queue: WorkQueue::new(threads, chunks),
             pair_queue: WorkQueue::new(threads, chunks),
             pairs_done: Marks::new(chunks),
+            wall_queue: WorkQueue::new(threads, chunks),
+            walls_done: Marks::new(chunks),
+            walls,
+            wall_views,
             rebuild_queue: WorkQueue::new(threads, chunks),
             list: Shared::new(list),
             arrays,
@@ -426,6 +465,9 @@ struct Worker<'t, 'a, L: ContactLaw> {
     pumped: f64,
     /// The contact samples it took (thread 0 only).
     samples: Vec<(u64, Vec<SampledContact>)>,
+    /// The flat walls where they are at this step: every thread moves its own copy at its
+    /// drifts, by the same arithmetic.
+    walls: Vec<Wall>,
 }
 
 impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
@@ -443,6 +485,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             deepest: 0.0,
             pumped: 0.0,
             samples: Vec::new(),
+            walls: team.walls.clone(),
         }
     }
 
@@ -465,6 +508,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                 self.rebuild(s);
             }
             self.pair_forces(s);
+            self.wall_contacts(s);
             self.sample_contacts(s);
         }
         self.kick_and_drift::<ROT, GRAV>(Some(steps), false);
@@ -482,6 +526,7 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             deepest: self.deepest,
             pumped: self.pumped,
             samples: std::mem::take(&mut self.samples),
+            walls: self.walls.clone(),
         }
     }
 
@@ -506,10 +551,13 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
                     let (first, end) = self.arr.needs.get(c);
                     let w = team.pairs_done.wait(first as usize..end as usize, round);
                     waited += w.as_nanos() as u64;
+                    if team.wall_views.count > 0 {
+                        waited += team.walls_done.wait(c..c + 1, round).as_nanos() as u64;
+                    }
                 }
                 particle_pass::<L::History, ROT, GRAV>(
                     &team.kick,
-                    &self.arr,
+                    (&self.arr, &team.wall_views),
                     a,
                     b,
                     gather.is_some(),
@@ -519,6 +567,12 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
             };
             for (m, x) in v2.iter_mut().zip(seen) {
                 *m = m.max(x);
+            }
+        }
+        if drift {
+            // a wall moves rigidly, x += v·dt, as a prescribed sphere does
+            for w in &mut self.walls {
+                w.point += w.velocity * team.kick.dt;
             }
         }
         self.laps.lap(&mut self.times.integrate);
@@ -549,6 +603,9 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         self.team.particle_queue.refill(self.tid);
         if s > 0 {
             self.team.pair_queue.refill(self.tid);
+            if self.team.wall_views.count > 0 {
+                self.team.wall_queue.refill(self.tid);
+            }
         }
     }
 
@@ -600,6 +657,34 @@ impl<'t, 'a, L: ContactLaw> Worker<'t, 'a, L> {
         // rebuild.
         self.arr = unsafe { *team.arrays.read() };
         self.laps.lap(&mut self.times.neighbor);
+    }
+
+    /// Wall stage of step `s` over the particle chunks this thread takes, each marked done for
+    /// its gather: every free sphere against every flat wall ([`walls::wall_chunk`]). Nothing
+    /// when the case has no walls.
+    fn wall_contacts(&mut self, s: u64) {
+        let team = self.team;
+        if team.wall_views.count == 0 {
+            return;
+        }
+        let (dt, overlap) = (team.kick.dt, team.guard.overlap);
+        while let Some(c) = team.wall_queue.next(self.tid) {
+            // SAFETY: a chunk is taken by one thread; its particles are written by the particle
+            // pass only after this chunk is marked done; their wall slots are theirs alone.
+            let watch = unsafe {
+                let chunk = self.arr.particle_chunks.get(c);
+                let (law, views) = (team.law, &team.wall_views);
+                wall_chunk(law, &self.walls, views, &self.arr, chunk, dt, overlap)
+            };
+            self.supplied += watch.wall_work;
+            self.flows.add(&watch.flows);
+            self.flows.wall_work += watch.wall_work;
+            if let Some(b) = watch.breach {
+                team.alarm.raise(s, b);
+            }
+            team.walls_done.set(c, s + 1);
+        }
+        self.laps.lap(&mut self.times.forces);
     }
 
     /// Thread 0 takes a contact sample of the step that the pair pass of step `s` has just

@@ -111,6 +111,7 @@ pub fn cluster(case: &Case) -> Scene {
         ),
         particles,
         time: 0.0,
+        walls: Vec::new(),
     }
 }
 

@@ -218,6 +218,8 @@ pub fn drive(
             r: row.x[1] - row.x[0],
             rad_p: radius[1],
             rad_i: radius[0],
+            inv_mass_p: 0.0,
+            inv_mass_i: 0.0,
             v_p: v[1],
             v_i: v[0],
             w_p: w[1],

@@ -26,6 +26,7 @@ pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
 pub mod refinement;
+pub mod walls;
 
 use std::path::Path;
 
@@ -346,6 +347,7 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
         Entry::new(per_convention(&["oblique", "opposite spins"]), move || {
             oblique::rows(&load("oblique_impact.toml")?)
         }),
+        Entry::new(["plane"], move || walls::rows(&load("wall_impact.toml")?)),
     ];
     for case in MOTION_CASES {
         for conv in Tangential::ALL {

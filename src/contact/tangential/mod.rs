@@ -105,9 +105,13 @@ impl TangentialModel for Frictionless {
     const SPLITS_DISSIPATION: bool = true;
 }
 
-/// The normal of the previous step, n_old = (r − (v_P − v_I)·dt)/|…| (unit, from I to P).
+/// The normal of the previous step, n_old = (r − (v_P − v_I)·dt)/|…| (unit, from I to P); a
+/// plane's own (`dist` infinite: a flat wall does not turn).
 #[inline(always)]
 pub fn previous_normal(k: &PairKinematics, dt: f64) -> Vec3 {
+    if k.dist.is_infinite() {
+        return k.n;
+    }
     (k.r - k.v_centres * dt).normalize()
 }
 
@@ -197,6 +201,8 @@ pub(crate) fn test_kinematics(r: Vec3, v_p: Vec3, w_p: Vec3, w_i: Vec3) -> PairK
         r,
         rad_p: 0.5,
         rad_i: 0.5,
+        inv_mass_p: 0.0,
+        inv_mass_i: 0.0,
         v_p,
         v_i: Vec3::zeros(),
         w_p,

@@ -43,7 +43,7 @@ impl Slip for FullRadiusSlip {
     const SCALES_CENTRES: bool = false;
     #[inline(always)]
     fn slip(k: &PairKinematics, _: f64) -> Vec3 {
-        let v = k.v_centres - (k.rad_p * k.w_p + k.rad_i * k.w_i).cross(&k.n);
+        let v = k.v_centres - (k.rad_p * k.w_p + k.spin_arm_i()).cross(&k.n);
         v - v.dot(&k.n) * k.n
     }
 }
@@ -68,8 +68,7 @@ impl Slip for ObjectiveSlip {
 /// The objective slip with the lever arms along `m`, tangential part with respect to `m`.
 #[inline(always)]
 fn objective_slip(k: &PairKinematics, m: Vec3) -> Vec3 {
-    let alpha = (k.rad_p + k.rad_i) / k.dist;
-    let v = alpha * k.v_centres - (k.rad_p * k.w_p + k.rad_i * k.w_i).cross(&m);
+    let v = k.alpha() * k.v_centres - (k.rad_p * k.w_p + k.spin_arm_i()).cross(&m);
     v - v.dot(&m) * m
 }
 

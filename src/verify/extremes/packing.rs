@@ -211,6 +211,7 @@ pub fn jammed(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         domain,
         particles,
         time: 0.0,
+        walls: Vec::new(),
     };
     let mut e = super::engine_of(&case, scene)?;
     let outcome = e.advance(0);
@@ -372,6 +373,7 @@ pub fn dense_shear(inputs: &Inputs) -> anyhow::Result<Vec<MapRow>> {
         domain,
         particles,
         time: 0.0,
+        walls: Vec::new(),
     };
     // the relaxed state as an initial file, which the case text names as a user's would
     let relaxed = super::engine_of(&base, scene)?.snapshot();
