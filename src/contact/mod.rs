@@ -60,6 +60,18 @@ pub struct PairKinematics {
     pub w_i: Vec3,
 }
 
+impl PairKinematics {
+    /// Effective radius R* = r_P·r_I/(r_P + r_I) (length); r_P for a plane (r_I infinite).
+    #[inline(always)]
+    pub fn r_star(&self) -> f64 {
+        if self.rad_i.is_infinite() {
+            self.rad_p
+        } else {
+            self.rad_p * self.rad_i / (self.rad_p + self.rad_i)
+        }
+    }
+}
+
 /// Everything known about the two spheres of a candidate pair.
 #[derive(Clone, Copy, Debug)]
 pub struct PairInput {
