@@ -279,8 +279,9 @@ mod tests {
         let mut area = 0.0;
         for j in 0..n {
             let d = -d_star + (j as f64 + 0.5) * h;
-            area += (unloading_force(d, d_star, t_star, limit, k)
-                - reloading_force(d, d_star, t_star, limit, k))
+            // the reloading branch lies above the unloading one: ∮T dδt = ∫(T_r − T_u) dδt
+            area += (reloading_force(d, d_star, t_star, limit, k)
+                - unloading_force(d, d_star, t_star, limit, k))
                 * h;
         }
         let w = dissipated_per_cycle(t_star, limit, k);
