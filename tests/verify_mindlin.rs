@@ -106,3 +106,84 @@ fn the_reference_law_is_objective_under_rigid_rotations() {
     let lammps = mindlin_histories::history_rows(Tangential::MindlinLammps, "rotation");
     assert!(lammps.iter().any(|r| !r.passed()), "{lammps:#?}");
 }
+
+/// Two spheres of radius 0.5 meeting obliquely in a closed box, with the law `law`.
+fn oblique_pair<L: verdem::contact::ContactLaw>(law: L) -> verdem::step::Simulation<L> {
+    use verdem::state::{Domain, Motion, Particles};
+    use verdem::Vec3;
+    let domain = Domain::new(
+        Vec3::new(-5.0, -5.0, -5.0),
+        Vec3::new(5.0, 5.0, 5.0),
+        [false; 3],
+    );
+    let mut p = Particles::default();
+    for (z, v) in [(-0.52, 0.5), (0.52, -0.5)] {
+        let (x, v) = (Vec3::new(0.0, 0.0, z), Vec3::new(0.4 * v, 0.0, v));
+        p.push(x, v, Vec3::zeros(), 0.5, 1.0, Motion::Free);
+    }
+    let builder =
+        verdem::step::neighbor::NeighborBuilder::new(0.1, 0.0, 0.5, verdem::case::Search::AllPairs);
+    let core = verdem::step::Core::new(domain, p, 1e-3, None, builder, 1);
+    verdem::step::Simulation::new(law, core)
+}
+
+/// A run of `law` in contact: its history's words are in the snapshot (all `words` of them,
+/// a tangential force loaded), in the hash, and a checkpoint resumes it bit for bit.
+fn resumes_bit_for_bit<L: verdem::contact::ContactLaw + Clone>(law: L, words: usize) {
+    use verdem::step::Engine;
+    let mut sim = oblique_pair(law.clone());
+    sim.advance(60).unwrap();
+    let snap = sim.snapshot();
+    assert_eq!(snap.contacts.len(), 1, "the spheres touch after 60 steps");
+    let history = snap.contacts[0].history.clone();
+    assert_eq!(history.len(), words);
+    assert!(history[..3].iter().any(|w| *w != 0.0), "{history:?}");
+    let mut other = snap.clone();
+    other.contacts[0].history[words - 1] *= 1.0 + 1e-15;
+    assert_ne!(
+        verdem::io::hash::state_hash(&snap),
+        verdem::io::hash::state_hash(&other)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let ck = dir.path().join("mindlin.checkpoint");
+    verdem::io::checkpoint::write(&ck, &snap, 1e-3, "mindlin:1").unwrap();
+    let mut resumed = oblique_pair(law);
+    resumed.advance(0).unwrap();
+    verdem::io::checkpoint::read(&ck, &mut resumed, "mindlin:1").unwrap();
+    assert_eq!(resumed.snapshot().contacts[0].history, history);
+    sim.advance(5).unwrap();
+    resumed.advance(5).unwrap();
+    assert_eq!(
+        verdem::io::hash::state_hash(&sim.snapshot()),
+        verdem::io::hash::state_hash(&resumed.snapshot())
+    );
+}
+
+/// The Mindlin histories (a force and the contact radius and stiffness, five words; the
+/// Mindlin–Deresiewicz force, turning points, branch and stiffness, eleven) run through the
+/// solver, the hash and a checkpoint resume with no change to any of them.
+#[test]
+fn mindlin_histories_resume_bit_for_bit_from_a_checkpoint() {
+    use verdem::contact::tangential::mindlin::deresiewicz::MindlinDeresiewicz;
+    use verdem::contact::tangential::mindlin::kratos::KratosHertzMindlin;
+    use verdem::contact::{Composed, LinearSpringDashpot};
+    let normal = LinearSpringDashpot {
+        kn: 1e3,
+        gamman: 0.0,
+    };
+    let g_star = 800.0;
+    resumes_bit_for_bit(
+        Composed {
+            normal,
+            tangential: MindlinDeresiewicz::new(g_star, 0.0, 0.3),
+        },
+        11,
+    );
+    resumes_bit_for_bit(
+        Composed {
+            normal,
+            tangential: KratosHertzMindlin::new(8.0 * g_star, 0.0, 0.3),
+        },
+        5,
+    );
+}
