@@ -23,7 +23,7 @@ fn the_reference_law_follows_the_loop_to_second_order() {
         );
     }
     let rows = mindlin_loop::convention_rows(Tangential::MindlinDeresiewicz);
-    assert_eq!(rows.len(), 10);
+    assert_eq!(rows.len(), 15);
     assert!(rows.iter().all(|r| r.gate && r.passed()), "{rows:#?}");
 }
 

@@ -53,14 +53,14 @@ pub fn dissipated_per_cycle(t_star: f64, limit: f64, k: f64) -> f64 {
         * (1.0 - (1.0 - x).powf(5.0 / 3.0) - 5.0 * x / 6.0 * (1.0 + (1.0 - x).powf(2.0 / 3.0)))
 }
 
-/// The contact the Mindlin rows drive: two spheres of radii `radius` (P, I; length) of one
-/// material of Young's modulus `youngs` (force/length²) and Poisson's ratio `poisson`, with
-/// friction `mu` (dashpots off), at the overlap `delta` (length) to start.
+/// The contact the Mindlin rows drive: two spheres of radii `radius` (P, I; length) of
+/// Young's moduli `youngs` (force/length²) and Poisson's ratios `poisson`, with friction `mu`
+/// (dashpots off), at the overlap `delta` (length) to start.
 #[derive(Clone, Copy, Debug)]
 pub struct Pair {
     pub radius: [f64; 2],
-    pub youngs: f64,
-    pub poisson: f64,
+    pub youngs: [f64; 2],
+    pub poisson: [f64; 2],
     pub mu: f64,
     pub delta: f64,
 }
@@ -71,21 +71,39 @@ impl Pair {
     pub fn aluminium(other: f64) -> Pair {
         Pair {
             radius: [0.01, other],
-            youngs: 70e9,
-            poisson: 0.3,
+            youngs: [70e9; 2],
+            poisson: [0.3; 2],
             mu: 0.3,
             delta: 1e-5,
         }
     }
 
-    /// E* of the pair: E/(2(1 − ν²)) for one material (Johnson 1985, §4.2).
-    pub fn e_star(&self) -> f64 {
-        self.youngs / (2.0 * (1.0 - self.poisson * self.poisson))
+    /// The materials of Chung & Ooi 2011's test 1, one against the other: a glass sphere
+    /// (E = 48 GPa, ν = 0.20) on a limestone one (E = 20 GPa, ν = 0.25), both of radius 10 mm,
+    /// at the overlap 10 µm, μ = 0.3.
+    pub fn glass_limestone() -> Pair {
+        Pair {
+            radius: [0.01; 2],
+            youngs: [48e9, 20e9],
+            poisson: [0.2, 0.25],
+            mu: 0.3,
+            delta: 1e-5,
+        }
     }
 
-    /// G* of the pair: G/(2(2 − ν)) with G = E/(2(1 + ν)) for one material (Mindlin 1949).
+    /// E* of the pair: 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (Johnson 1985, §4.2).
+    pub fn e_star(&self) -> f64 {
+        let [e1, e2] = self.youngs;
+        let [n1, n2] = self.poisson;
+        1.0 / ((1.0 - n1 * n1) / e1 + (1.0 - n2 * n2) / e2)
+    }
+
+    /// G* of the pair: 1/G* = (2 − ν₁)/G₁ + (2 − ν₂)/G₂ with G = E/(2(1 + ν)) (Mindlin 1949).
     pub fn g_star(&self) -> f64 {
-        self.youngs / (2.0 * (1.0 + self.poisson)) / (2.0 * (2.0 - self.poisson))
+        let g = |e: f64, n: f64| e / (2.0 * (1.0 + n));
+        let [e1, e2] = self.youngs;
+        let [n1, n2] = self.poisson;
+        1.0 / ((2.0 - n1) / g(e1, n1) + (2.0 - n2) / g(e2, n2))
     }
 
     /// R* = R_P R_I/(R_P + R_I) (length).
@@ -299,5 +317,14 @@ mod tests {
         assert!((p.g_star() - 1.0 / (2.0 * (2.0 - 0.3) / g)).abs() < 1e-3);
         assert!((p.e_star() - 1.0 / (2.0 * (1.0 - 0.09) / 70e9)).abs() < 1e-3);
         assert_eq!(p.r_star(), 0.005);
+        // glass on limestone: G = 20 GPa and 8 GPa, G* = 1/(1.8/G1 + 1.75/G2)
+        let q = Pair::glass_limestone();
+        let expected = 1.0 / (1.8 / 20e9 + 1.75 / 8e9);
+        assert!(
+            (q.g_star() / expected - 1.0).abs() < 1e-14,
+            "{}",
+            q.g_star()
+        );
+        assert!((q.e_star() - 1.0 / (0.96 / 48e9 + 0.9375 / 20e9)).abs() < 1e-3);
     }
 }

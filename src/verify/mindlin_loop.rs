@@ -30,11 +30,13 @@ const FORCE_TOL: f64 = 1e-7;
 /// Relative tolerance of the energy a cycle dissipates.
 const ENERGY_TOL: f64 = 1e-6;
 
-/// The pairs of the loop rows: equal spheres and unlike sizes (R_I = 2R_P), by name.
-pub fn pairs() -> [(&'static str, Pair); 2] {
+/// The pairs of the loop rows, by name: equal spheres, unlike sizes (R_I = 2R_P) and unlike
+/// materials (glass on limestone).
+pub fn pairs() -> [(&'static str, Pair); 3] {
     [
         ("equal", Pair::aluminium(0.01)),
         ("unlike", Pair::aluminium(0.02)),
+        ("glass-limestone", Pair::glass_limestone()),
     ]
 }
 
