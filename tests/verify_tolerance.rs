@@ -87,7 +87,7 @@ fn a_law_with_mu_off_by_a_tenth_of_a_percent_fails_the_coulomb_rows_of_every_con
     let rows = verdem::verify::oblique::rows_against(&case, &wrong).unwrap();
     let n = count(&rows, impulse, "");
     // 3 sliding incidences and a spin-only slide per convention
-    assert_eq!(n, 4 * verdem::contact::Tangential::ALL.len());
+    assert_eq!(n, 4 * verdem::contact::Tangential::with_constant_kt().count());
     assert_eq!(failed(&rows, impulse, "").len(), n, "{rows:#?}");
 }
 
@@ -128,7 +128,7 @@ fn histories(subject: &Subject) -> Vec<Row> {
 /// passes it unless `others` (rows a change of this parameter is expected to move too).
 fn a_law_off_by_1e_4_fails(change: fn(&mut Case), variant: &str, catching: &str, others: &[&str]) {
     let wrong = Wrong(change);
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         let right = histories(&Subject::own(conv));
         assert!(right.iter().all(|r| r.passed() || !r.gate), "{right:#?}");
         for subject in [
@@ -216,7 +216,7 @@ fn a_law_with_mu_off_by_1e_4_fails_the_sliding_row_of_every_convention() {
 /// of those forces.
 #[test]
 fn every_convention_measures_its_dashpots_to_round_off() {
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         let rows = histories(&Subject::own(conv));
         let dashpots: Vec<_> = rows
             .iter()

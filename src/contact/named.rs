@@ -7,7 +7,7 @@ use std::sync::LazyLock;
 
 use serde::de::Error as _;
 
-use super::{Normal, Tangential};
+use super::{Normal, Parameters, Tangential};
 use crate::case::{self, Case, CaseError};
 
 /// The registries' names, in their order, as serde's messages list a field's choices.
@@ -28,10 +28,27 @@ fn unknown(named: &case::Convention, field: &str, names: &'static [&'static str]
 
 impl Tangential {
     /// The convention `contact.tangential` names, or the error `file:line:
-    /// contact.tangential: unknown variant …` at the line that names it.
+    /// contact.tangential: unknown variant …` at the line that names it; for a convention with
+    /// Mindlin's stiffness ([`crate::contact::Properties::mindlin_stiffness`]) in a case that
+    /// gives no elastic constants (G* = 0), the error `… needs the material's youngs and
+    /// poisson` at the same line.
     pub fn of(contact: &case::Contact) -> Result<Tangential, CaseError> {
         let named = &contact.tangential;
-        Tangential::named(named.name()).ok_or_else(|| unknown(named, "contact.tangential", &NAMES))
+        let t = Tangential::named(named.name())
+            .ok_or_else(|| unknown(named, "contact.tangential", &NAMES))?;
+        if t.properties().mindlin_stiffness && Parameters::of(contact).g_star <= 0.0 {
+            return Err(CaseError {
+                file: named.file.clone(),
+                line: named.line,
+                field: "contact.tangential".into(),
+                msg: format!(
+                    "`{}` has Mindlin's stiffness 8G*a: it needs the material's youngs and \
+                     poisson (the case gives no elastic constants, so G* = 0)",
+                    t.name()
+                ),
+            });
+        }
+        Ok(t)
     }
 }
 
@@ -83,7 +100,7 @@ mod tests {
     #[test]
     fn a_case_names_a_convention_or_gets_the_list() {
         let text = include_str!("../../cases/shear_flow_quick.toml");
-        for t in Tangential::ALL {
+        for t in Tangential::with_constant_kt() {
             let named = text.replace(
                 "tangential = \"mercury\"",
                 &format!("tangential = \"{}\"", t.name()),
@@ -109,6 +126,34 @@ mod tests {
             )),
             "{e}"
         );
-        assert!(e.ends_with("`objective`"), "{e}");
+        assert!(e.ends_with("`mindlin-deresiewicz`"), "{e}");
+    }
+
+    /// A Mindlin convention in a case without elastic constants is refused at the line that
+    /// names it, saying what it needs.
+    #[test]
+    fn a_mindlin_convention_needs_the_material_s_elastic_constants() {
+        let text = include_str!("../../cases/shear_flow_quick.toml");
+        let line = text
+            .lines()
+            .position(|l| l.starts_with("tangential"))
+            .unwrap()
+            + 1;
+        for t in Tangential::with_mindlin_stiffness() {
+            let named = text.replace(
+                "tangential = \"mercury\"",
+                &format!("tangential = \"{}\"", t.name()),
+            );
+            let case = case::Case::parse(&named, "q.toml").unwrap();
+            let e = Tangential::of(&case.contact).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!(
+                    "q.toml:{line}: contact.tangential: `{}`",
+                    t.name()
+                )) && e.contains("needs the material's youngs and poisson"),
+                "{e}"
+            );
+        }
+        assert!(Tangential::with_mindlin_stiffness().count() >= 8);
     }
 }

@@ -108,6 +108,8 @@ mod tests {
             kt: 0.0,
             gammat: 0.0,
             mu: 0.0,
+            e_star: 0.0,
+            g_star: 0.0,
         };
         let f = Normal::Linear.with_model(
             &params,

@@ -17,6 +17,12 @@ pub struct Parameters {
     pub gammat: f64,
     /// Coulomb friction coefficient (dimensionless).
     pub mu: f64,
+    /// Effective Young's modulus of the pair, E* (force/length²): 1/E* = (1−ν₁²)/E₁ + (1−ν₂²)/E₂
+    /// (Johnson, Contact Mechanics, 1985, §4.2); 0 when the case gives no elastic constants.
+    pub e_star: f64,
+    /// Effective shear modulus of the pair, G* (force/length²): 1/G* = (2−ν₁)/G₁ + (2−ν₂)/G₂,
+    /// G = E/(2(1+ν)) (Mindlin 1949); 0 when the case gives no elastic constants.
+    pub g_star: f64,
 }
 
 impl Parameters {
@@ -28,6 +34,8 @@ impl Parameters {
             kt: c.kt,
             gammat: c.gammat,
             mu: c.mu,
+            e_star: 0.0,
+            g_star: 0.0,
         }
     }
 }

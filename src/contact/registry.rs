@@ -13,6 +13,14 @@ use super::tangential::conventions::{
     Cundall1979, LammpsGranular, LammpsHookeHistory, Liggghts, MercurySlidingFriction, Objective,
     YadeApprox, YadeViscEl,
 };
+use super::tangential::mindlin::deresiewicz::MindlinDeresiewicz;
+use super::tangential::mindlin::force::LammpsMindlinForce;
+use super::tangential::mindlin::kratos::KratosHertzMindlin;
+use super::tangential::mindlin::lammps::LammpsMindlin;
+use super::tangential::mindlin::liggghts::LiggghtsMindlin;
+use super::tangential::mindlin::mercury::MercuryMindlin;
+use super::tangential::mindlin::rescale::LammpsMindlinRescale;
+use super::tangential::mindlin::yade::YadeMindlin;
 use super::tangential::Arms;
 use super::{Parameters, TangentialModel};
 
@@ -33,6 +41,15 @@ pub struct Properties {
     /// The torques' lever arms reach the contact point where the force acts (R − δ/2), so a
     /// contact conserves angular momentum; full radii leave δ n × Ft per contact.
     pub conserves_angular_momentum: bool,
+    /// The stiffness source: the spring is Mindlin's, kt = c·8G*·a from the material's elastic
+    /// constants and the contact radius a = √(R*δ), not the case's constant kt. Rows that
+    /// assume a constant kt run only the conventions without it ([`Tangential::constant_kt`]);
+    /// a case naming it needs the material's youngs and poisson (`contact::named`).
+    pub mindlin_stiffness: bool,
+    /// Mindlin–Deresiewicz partial slip: the stiffness falls with the mobilised friction and
+    /// a cycle at constant normal load follows the closed-form hysteresis loop (the Mindlin
+    /// rows judge the loop for it and report it for the no-slip laws).
+    pub partial_slip: bool,
 }
 
 impl Properties {
@@ -42,6 +59,8 @@ impl Properties {
         twists_spring: false,
         drops_dashpot_while_sliding: false,
         conserves_angular_momentum: false,
+        mindlin_stiffness: false,
+        partial_slip: false,
     };
 }
 
@@ -127,6 +146,22 @@ macro_rules! conventions {
                 }
             }
 
+            /// Whether the convention's spring is the case's constant kt (it declares no
+            /// [`Properties::mindlin_stiffness`]): the rows that assume one run it.
+            pub fn constant_kt(self) -> bool {
+                !self.properties().mindlin_stiffness
+            }
+
+            /// The conventions with the case's constant kt, in the registry's order.
+            pub fn with_constant_kt() -> impl Iterator<Item = Tangential> {
+                Tangential::ALL.into_iter().filter(|t| t.constant_kt())
+            }
+
+            /// The conventions with Mindlin's stiffness 8G*a, in the registry's order.
+            pub fn with_mindlin_stiffness() -> impl Iterator<Item = Tangential> {
+                Tangential::ALL.into_iter().filter(|t| !t.constant_kt())
+            }
+
             /// What the convention claims (see [`Properties`]), and whether its torques conserve
             /// angular momentum (their arms reach the contact point).
             pub fn properties(self) -> Properties {
@@ -172,6 +207,22 @@ conventions! {
         "Cundall & Strack 1979: no frame update at all";
     Objective = "objective", |p| Objective::new(p.kt, p.gammat, p.mu), [objective, twists_spring],
         "The objective reference law: exact rotation with the contact frame, objective slip";
+    MindlinLammps = "mindlin-lammps", |p| LammpsMindlin::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness],
+        "LAMMPS `tangential mindlin`: displacement at the current stiffness 8G*a, project and rescale";
+    MindlinRescale = "mindlin-rescale", |p| LammpsMindlinRescale::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness],
+        "LAMMPS `tangential mindlin_rescale`: displacement scaled by a/a_prev on unloading";
+    MindlinForce = "mindlin-force", |p| LammpsMindlinForce::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness],
+        "LAMMPS `tangential mindlin/force`: incremental force, dF = -8G*a vt dt";
+    MindlinLiggghts = "mindlin-liggghts", |p| LiggghtsMindlin::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness, drops_dashpot_while_sliding],
+        "LIGGGHTS `model hertz tangential history`: displacement at 8G*a, projected; cap on the spring only";
+    MindlinKratos = "mindlin-kratos", |p| KratosHertzMindlin::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness],
+        "Kratos `DEM_D_Hertz_viscous_Coulomb`: incremental force, scaled by sqrt(delta/delta_prev) on unloading";
+    MindlinYade = "mindlin-yade", |p| YadeMindlin::new(8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness, twists_spring],
+        "Yade `MindlinPhys`: incremental force, first-order rotation, objective slip";
+    MindlinMercury = "mindlin-mercury", |p| MercuryMindlin::new(2.0 / 3.0 * 8.0 * p.g_star, p.gammat, p.mu), [mindlin_stiffness, drops_dashpot_while_sliding],
+        "MercuryDPM `MindlinInteraction`: rate-form displacement, Di Renzo & Di Maio's 2/3 of 8G*a";
+    MindlinDeresiewicz = "mindlin-deresiewicz", |p| MindlinDeresiewicz::new(p.g_star, p.gammat, p.mu), [mindlin_stiffness, partial_slip, twists_spring],
+        "The reference Mindlin-Deresiewicz partial slip with turning points, objective frame update";
 }
 
 #[cfg(test)]
@@ -210,20 +261,23 @@ mod tests {
         }
     }
 
-    /// Every convention splits its dissipation so that, over a contact that sticks and then
+    /// Every convention with a constant kt splits its dissipation so that, over a contact that sticks and then
     /// slides, the work its force takes is what its spring holds plus what its dashpot and slider
     /// report, to a step's share of the work (the springs' work and energy telescope up to the
     /// two ends). Counting the spring energy the cap's reset releases as the slider's would
-    /// leave ½·kt·|slip·dt|² a sliding step unaccounted: 0.7 % of the work here.
+    /// leave ½·kt·|slip·dt|² a sliding step unaccounted: 0.7 % of the work here. (The Mindlin
+    /// laws do not split theirs: the energy ledger says so.)
     #[test]
     fn every_convention_accounts_for_the_work_its_tangential_force_takes() {
-        for t in Tangential::ALL {
+        for t in Tangential::with_constant_kt() {
             let params = Parameters {
                 kn: 1e4,
                 gamman: 1.0,
                 kt: 1000.0,
                 gammat: 5.0,
                 mu: 0.3,
+                e_star: 0.0,
+                g_star: 0.0,
             };
             let missing = t.with_model(&params, Unaccounted { steps: 500 });
             assert!(

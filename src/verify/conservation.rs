@@ -168,7 +168,7 @@ pub fn rows(base: &Case, steps: u64) -> anyhow::Result<Vec<Row>> {
         friction.momentum_change,
         1e-12,
     ));
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         let mut case = base.clone();
         case.contact.tangential = conv.into();
         let dl = cluster_angular_momentum(&case, 2000)?;

@@ -9,7 +9,11 @@
 //!   2008), per convention;
 //! - [`histories`]: the tangential spring loaded and unloaded, taken to the Coulomb limit and
 //!   back, and reset when the contact opens, per convention;
-//! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster.
+//! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster;
+//! - [`mindlin_loop`]: Mindlin–Deresiewicz's hysteresis loop at constant normal load, per
+//!   Mindlin convention, against its closed form ([`mindlin`]);
+//! - [`mindlin_histories`]: held tangential displacement under a changing overlap, closed cycles
+//!   of normal and tangential load (net work), rigid rotations, per Mindlin convention.
 //!
 //! The table is a list of named [`Entry`]s, selected by name before any of them runs. The
 //! prescribed-motion cases (objectivity, ratchet, histories) drive their contact through a
@@ -22,6 +26,9 @@ pub mod extremes;
 pub mod histories;
 pub mod kinematics;
 pub mod mcnamara;
+pub mod mindlin;
+pub mod mindlin_histories;
+pub mod mindlin_loop;
 pub mod objectivity;
 pub mod oblique;
 pub mod ratchet;
@@ -336,7 +343,7 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
     let load = move |name: &str| Case::load(&dir.join(name));
     // the beginnings of the rows' case names, per convention where a case has one
     let per_convention = |kinds: &[&str]| -> Vec<String> {
-        let each = Tangential::ALL.into_iter().map(|c| c.name());
+        let each = Tangential::with_constant_kt().map(|c| c.name());
         each.flat_map(|c| kinds.iter().map(move |k| format!("{k} {c}")))
             .collect()
     };
@@ -350,7 +357,7 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
         Entry::new(["plane"], move || walls::rows(&load("wall_impact.toml")?)),
     ];
     for case in MOTION_CASES {
-        for conv in Tangential::ALL {
+        for conv in Tangential::with_constant_kt() {
             for &variant in case.variants {
                 list.push(Entry::new([(case.name)(conv.name(), variant)], move || {
                     case.judge(dir, &Subject::own(conv), variant)
@@ -363,6 +370,13 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
     list.push(Entry::new(conservation.chain(clusters), move || {
         conservation::rows(&load("conservation.toml")?, 1_000_000)
     }));
+    let loops = Tangential::with_mindlin_stiffness()
+        .flat_map(|c| mindlin_loop::pairs().map(move |(p, _)| mindlin_loop::case_name(c, p)));
+    list.push(Entry::new(loops, || Ok(mindlin_loop::rows())));
+    let histories = Tangential::with_mindlin_stiffness().flat_map(|c| {
+        mindlin_histories::HISTORIES.map(move |h| mindlin_histories::case_name(c, h))
+    });
+    list.push(Entry::new(histories, || Ok(mindlin_histories::rows())));
     list
 }
 

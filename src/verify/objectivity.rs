@@ -152,7 +152,7 @@ pub fn axis_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Result<
 /// The objectivity rows of every tangential convention.
 pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         for label in AXES {
             rows.extend(axis_rows(base, &Subject::own(conv), label)?);
         }

@@ -92,7 +92,7 @@ pub fn rows_against(reference: &Case, simulated: &Case) -> anyhow::Result<Vec<Ro
     let cf = closed_form(base, m);
     let mu = c.mu;
     let mut rows = Vec::new();
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         let mut unclipped = simulated.clone();
         unclipped.contact.tangential = conv.into();
         unclipped.contact.clip_normal = false;

@@ -167,7 +167,7 @@ pub fn rotation_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Res
 /// The ratcheting rows of every tangential convention.
 pub fn rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         for label in ROTATIONS {
             rows.extend(rotation_rows(base, &Subject::own(conv), label)?);
         }

@@ -19,6 +19,7 @@
 pub mod cap;
 pub mod conventions;
 pub mod frame;
+pub mod mindlin;
 pub mod slip;
 
 use std::marker::PhantomData;
