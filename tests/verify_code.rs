@@ -1,7 +1,9 @@
 //! `verdem verify --code`: the prescribed-motion cases run through an external program
 //! (tests/code/contact_law.py, MercuryDPM's law written independently in Python, with and
-//! without known defects; verdem's own `kinematics` command; broken programs) and judged in
-//! the same table.
+//! without known defects; tests/code/objective_law.py and tests/code/interface_law.py,
+//! objective laws written from docs/code-interface.md; verdem's own `kinematics` command;
+//! broken programs) and judged in the same table, with the summary's diagnosis of the failed
+//! rows by the property they test.
 
 mod common;
 
@@ -10,6 +12,7 @@ use std::path::Path;
 
 use verdem::case::Case;
 use verdem::contact::Tangential;
+use verdem::verify::diagnosis::{self, Property};
 use verdem::verify::driver::{External, MotionDriver, OWN};
 use verdem::verify::kinematics::{self, ForceRow, MotionRow};
 use verdem::verify::{self, Row, Subject};
@@ -84,6 +87,28 @@ fn failed(rows: &[Row]) -> BTreeSet<(String, String)> {
         .filter(|r| r.gate && !r.passed())
         .map(|r| (r.case.clone(), r.quantity.clone()))
         .collect()
+}
+
+/// The summary's diagnosis of `rows` names `causes` as the properties that failed on their
+/// own, each with its typical defect and its pointer, and the others as following from them.
+fn assert_diagnosed(rows: &[Row], causes: &[Property]) {
+    let d = diagnosis::diagnose(rows);
+    let summary = d.summary();
+    assert_eq!(d.causes(), causes, "{summary}");
+    assert_eq!(d.undeclared, 0, "{summary}");
+    for f in &d.findings {
+        let line = summary
+            .lines()
+            .find(|l| l.starts_with(&format!("  {},", f.property.title())))
+            .unwrap_or_else(|| panic!("{:?}: {summary}", f.property));
+        assert!(line.contains(f.property.defect()), "{line}");
+        assert!(line.ends_with(&f.property.docs()), "{line}");
+        assert_eq!(
+            line.contains("perhaps only through"),
+            !f.after.is_empty(),
+            "{line}"
+        );
+    }
 }
 
 #[test]
@@ -313,6 +338,8 @@ fn a_tangential_stiffness_10_percent_off_fails_the_spring_force_and_energy_rows(
         ])
     );
     assert_passes(&rows, &["contact loss"]);
+    // the stiffness; the Coulomb way back and the cycles are measured in kt
+    assert_diagnosed(&rows, &[Property::Stiffness]);
 }
 
 #[test]
@@ -351,6 +378,7 @@ fn torques_of_the_wrong_sign_fail_the_torque_and_work_rows() {
         ])
     );
     assert_passes(&rows, &["contact loss"]);
+    assert_diagnosed(&rows, &[Property::Torques]);
 }
 
 #[test]
@@ -361,6 +389,7 @@ fn a_spring_kept_through_a_contact_loss_fails_the_reset_row() {
         set(&[("tangential code:law contact loss", "|Ft| back / (mu fn)")])
     );
     assert_passes(&rows, &["load-unload", "coulomb limit"]);
+    assert_diagnosed(&rows, &[Property::ResetAtLoss]);
 }
 
 /// `verdem verify --code CMD --only load-unload`: its exit status, standard output and error.
@@ -575,15 +604,46 @@ fn a_spring_wound_past_the_cap_fails_the_way_back_from_the_coulomb_limit() {
         )])
     );
     assert_passes(&rows, &["load-unload", "contact loss"]);
+    assert_diagnosed(&rows, &[Property::CoulombCap]);
+}
+
+#[test]
+fn a_spring_kept_after_the_contact_is_lost_fails_the_reset_and_is_diagnosed_so() {
+    let rows = objective_rows_of("--defect reset", None, &["tangential"]);
+    assert_eq!(
+        failed(&rows),
+        set(&[("tangential code:obj contact loss", "|Ft| back / (mu fn)")])
+    );
+    assert_passes(&rows, &["load-unload", "coulomb limit"]);
+    assert_diagnosed(&rows, &[Property::ResetAtLoss]);
+    // judged at the motion's step only: a refined jump apart grazes the contact, where the
+    // cap would wipe the kept spring
+    let reset = rows.iter().find(|r| r.failed()).unwrap();
+    assert!(reset.measured_text.is_empty(), "{reset:?}");
 }
 
 #[test]
 fn a_spring_kept_in_the_lab_frame_fails_every_rotation_at_every_step() {
-    // the ratchet's two rotations (the objectivity rows about every axis fail too, but
-    // their 10⁵ rows refined to dt/4 are not run here); a history without rotation passes
-    let rows = objective_rows_of("--defect frame", None, &["ratchet", "load-unload"]);
+    // the ratchet's two rotations and the rotation about a tangent axis (the objectivity rows
+    // about the other axes fail too, but their 10⁵ rows refined to dt/4 are not run here); a
+    // history without rotation passes
+    let rows = objective_rows_of(
+        "--defect frame",
+        None,
+        &["ratchet", "load-unload", "tangent axis"],
+    );
+    let ratchet = |rows: &[Row]| -> BTreeSet<(String, String)> {
+        let mut f = failed(rows);
+        f.retain(|(case, _)| case.starts_with("ratchet"));
+        f
+    };
+    // |Ft| falls with the tilt (the direction stays in the plane of the rotation)
+    assert!(failed(&rows).contains(&(
+        "objectivity code:obj tangent axis".to_string(),
+        "|Ft| drift per rad".to_string()
+    )));
     assert_eq!(
-        failed(&rows),
+        ratchet(&rows),
         set(&[
             (
                 "ratchet code:obj rotation about n",
@@ -605,16 +665,28 @@ fn a_spring_kept_in_the_lab_frame_fails_every_rotation_at_every_step() {
         .iter()
         .filter(|r| r.gate && r.failed())
         .all(|r| r.measured_text.contains("at dt/4")));
+    // the frame; the closed cycles fail through it
+    assert_diagnosed(&rows, &[Property::Objectivity]);
 }
 
 #[test]
 fn a_spring_that_does_not_twist_fails_the_rotations_with_a_part_about_the_normal() {
-    // the ratchet's rotations, each with a part about the normal (the objectivity rows about
-    // the normal and oblique axes fail too, but their 10⁵ rows refined to dt/4 are not run
-    // here), and the rotation about a tangent axis, which passes
-    let rows = objective_rows_of("--defect twist", None, &["ratchet", "tangent axis"]);
+    // the ratchet's rotations, each with a part about the normal, and the rotation about the
+    // normal (the oblique axis fails too, but its 10⁵ rows refined to dt/4 are not run here),
+    // and the rotation about a tangent axis, which passes
+    let rows = objective_rows_of(
+        "--defect twist",
+        None,
+        &["ratchet", "tangent axis", "normal axis"],
+    );
+    let mut ratchet = failed(&rows);
+    ratchet.retain(|(case, _)| case.starts_with("ratchet"));
+    assert!(failed(&rows).contains(&(
+        "objectivity code:obj normal axis".to_string(),
+        "Ft direction error per rad".to_string()
+    )));
     assert_eq!(
-        failed(&rows),
+        ratchet,
         set(&[
             (
                 "ratchet code:obj rotation about n",
@@ -631,6 +703,8 @@ fn a_spring_that_does_not_twist_fails_the_rotations_with_a_part_about_the_normal
         ])
     );
     assert_passes(&rows, &["tangent axis"]);
+    // the twist; the closed cycles fail through it
+    assert_diagnosed(&rows, &[Property::SpringTwist]);
 }
 
 /// Without a convention the load/unload rows allow the spread of the conventions' lever arms
@@ -655,7 +729,151 @@ fn a_stiffness_off_by_1e_4_passes_unnamed_and_fails_when_the_law_names_its_conve
             ),
         ])
     );
+    // the stiffness; the Coulomb way back is measured in kt
+    assert_diagnosed(&named, &[Property::Stiffness]);
     // the correct law passes them named
     let right = only("", Some(Tangential::Objective));
     assert!(failed(&right).is_empty(), "{:#?}", failed(&right));
+}
+
+// tests/code/interface_law.py, written from docs/code-interface.md's row-by-row sections alone
+// with its own discretisation (the rows' own velocities, the spring projected onto the new
+// tangent plane and given back its length, the twist from the quaternions): it passes every
+// row, gated as an objective law, some by convergence.
+#[test]
+fn a_law_written_from_the_interface_page_alone_passes_every_row() {
+    let scratch = tempfile::tempdir().unwrap();
+    let program = External::new(&script("interface_law.py", ""), "newcomer", scratch.path());
+    let rows = code_rows(&program, None);
+    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4 + 2 * 2);
+    assert!(failed(&rows).is_empty(), "{:#?}", failed(&rows));
+    assert_eq!(diagnosis::diagnose(&rows).summary(), "");
+    // every row declares the property it tests
+    assert!(
+        rows.iter().all(|r| diagnosis::property(r).is_some()),
+        "{rows:#?}"
+    );
+}
+
+/// The command line prints the diagnosis under the table's counts and writes it, with each
+/// case's property, into the JSON report.
+#[test]
+fn the_command_line_prints_and_reports_the_diagnosis_of_the_failed_rows() {
+    let out = tempfile::tempdir().unwrap();
+    let json = out.path().join("r.json");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(["verify", "--only", "contact loss", "--code"])
+        .arg(script("objective_law.py", "--defect reset"))
+        .arg("--json")
+        .arg(&json)
+        .arg("--cases")
+        .arg(cases())
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert_eq!(run.status.code(), Some(1), "{text}");
+    let tail: Vec<&str> = text.lines().rev().take(3).collect();
+    assert!(tail[2].starts_with("3 passed, 1 failed"), "{text}");
+    assert_eq!(
+        tail[1],
+        "diagnosis, the failed rows by the property they test (docs/code-interface.md):"
+    );
+    let p = Property::ResetAtLoss;
+    assert_eq!(
+        tail[0],
+        format!(
+            "  {}, 1 row failed: {}; {}",
+            p.title(),
+            p.defect(),
+            p.docs()
+        )
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let d = report["diagnosis"].as_array().unwrap();
+    assert_eq!(d.len(), 1, "{report}");
+    assert_eq!(d[0]["property"], p.key());
+    assert_eq!(d[0]["failed"], 1);
+    assert_eq!(d[0]["docs"], p.docs());
+    assert!(d[0]["after"].as_array().unwrap().is_empty());
+    let keys: Vec<&str> = report["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["property"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            "forces-file",
+            "reset-at-contact-loss",
+            "normal-force",
+            "reset-at-contact-loss"
+        ]
+    );
+    // a passing run prints no diagnosis and reports none
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_verdem"))
+        .args(["verify", "--only", "contact loss", "--code"])
+        .arg(script("objective_law.py", ""))
+        .arg("--json")
+        .arg(&json)
+        .arg("--cases")
+        .arg(cases())
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{text}");
+    assert!(
+        text.ends_with("4 passed, 0 failed, 0 known defects of peer conventions (FAIL*)\n"),
+        "{text}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(report.get("diagnosis").is_none(), "{report}");
+}
+
+/// Every property's pointer names a section of docs/code-interface.md: a heading whose
+/// anchor (GitHub's: lower case, spaces as hyphens) is the property's key.
+#[test]
+fn every_pointer_of_the_diagnosis_names_a_section_of_the_interface_page() {
+    let page = std::fs::read_to_string(common::root().join("docs/code-interface.md")).unwrap();
+    let anchors: Vec<String> = page
+        .lines()
+        .filter_map(|l| l.strip_prefix("### "))
+        .map(|h| {
+            h.to_lowercase()
+                .chars()
+                .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-')
+                .map(|c| if c == ' ' { '-' } else { c })
+                .collect()
+        })
+        .collect();
+    for p in Property::ALL {
+        assert!(anchors.iter().any(|a| a == p.key()), "{p:?}: {anchors:?}");
+        // the section says the summary's line of the typical defect
+        let section = page.split("\n### ").find(|s| {
+            s.lines()
+                .next()
+                .is_some_and(|h| h.to_lowercase().replace(' ', "-") == p.key())
+        });
+        let section = section.unwrap_or_else(|| panic!("{p:?}"));
+        // in ASCII, as the summary writes it, and on one line
+        let ascii = section
+            .replace('−', "-")
+            .replace('δ', "delta")
+            .replace('μ', "mu")
+            .replace('γ', "gamma")
+            .replace('·', "*")
+            .replace('×', "x");
+        let words = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            words(&ascii).contains(p.defect()),
+            "{p:?}: its section does not say \"{}\"",
+            p.defect()
+        );
+    }
 }

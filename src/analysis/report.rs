@@ -56,6 +56,10 @@ pub struct Case {
     /// …), in the order its text table gives them; the field is absent when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub details: Vec<Detail>,
+    /// The key of the property the verdict tests, where it declares one (the field is absent
+    /// otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub property: Option<String>,
 }
 
 /// One more number of a row: its name, its value (`None` when it is not a finite number) and,
@@ -79,6 +83,23 @@ impl Detail {
     }
 }
 
+/// One property with failed cases: what a failure of it typically means.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnosis {
+    /// Its key, as the cases' `property`.
+    pub property: String,
+    /// Its name in words.
+    pub title: String,
+    /// How many of its cases failed.
+    pub failed: usize,
+    /// The keys of other failed properties its failure may follow from (empty: on its own).
+    pub after: Vec<String>,
+    /// What a subject that fails it typically does wrong.
+    pub defect: String,
+    /// Where it is defined.
+    pub docs: String,
+}
+
 /// A suite of test cases: one command's verdicts.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
@@ -90,6 +111,9 @@ pub struct Report {
     pub failures: usize,
     pub skipped: usize,
     pub cases: Vec<Case>,
+    /// The failed cases by the property they test (the field is absent when there are none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub diagnosis: Vec<Diagnosis>,
 }
 
 /// `v` in words: shortest round-trip decimal, `undefined` when not finite.
@@ -201,6 +225,7 @@ impl Case {
             message,
             undefined: None,
             details: Vec::new(),
+            property: v.property.map(String::from),
         }
     }
 
@@ -240,7 +265,14 @@ impl Report {
             failures: count(Status::Failed),
             skipped: count(Status::Skipped),
             cases,
+            diagnosis: Vec::new(),
         }
+    }
+
+    /// The same report with the diagnosis of its failed cases.
+    pub fn diagnosed(mut self, diagnosis: Vec<Diagnosis>) -> Report {
+        self.diagnosis = diagnosis;
+        self
     }
 
     /// JUnit XML: `<testsuites>` holding one `<testsuite>` with its counts, one `<testcase
@@ -290,8 +322,9 @@ impl Report {
     }
 
     /// The report as a JSON object: `suite`, the counts `tests`, `passed`, `failures`,
-    /// `skipped`, and `cases`, an array of objects with the fields of [`Case`] (numbers that are
-    /// not finite are `null`; `undefined` and `details` only where a report gives them).
+    /// `skipped`, `cases`, an array of objects with the fields of [`Case`] (numbers that are
+    /// not finite are `null`; `undefined`, `details` and `property` only where a report gives
+    /// them), and `diagnosis`, the fields of [`Diagnosis`], where cases of a property failed.
     pub fn json(&self) -> String {
         let mut s = serde_json::to_string_pretty(self).expect("a report serialises");
         s.push('\n');

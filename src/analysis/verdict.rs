@@ -79,6 +79,10 @@ pub struct Verdict {
     /// number (e.g. "chi2/dof = 1.20 (mean 0.00310)" and "< 3"); empty when the numbers say it.
     pub measured_text: String,
     pub expected_text: String,
+    /// The property of the judged subject the verdict tests, by its key (a contact law's
+    /// `coulomb-cap`: `verify::diagnosis` names and explains it, the reports carry it); none
+    /// where no property is declared.
+    pub property: Option<&'static str>,
 }
 
 impl Verdict {
@@ -97,6 +101,7 @@ impl Verdict {
             gate: true,
             measured_text: String::new(),
             expected_text: String::new(),
+            property: None,
         }
     }
 
@@ -141,6 +146,12 @@ impl Verdict {
     pub fn described(mut self, measured: String, expected: String) -> Verdict {
         self.measured_text = measured;
         self.expected_text = expected;
+        self
+    }
+
+    /// The same verdict, testing the property keyed `key`.
+    pub fn testing(mut self, key: &'static str) -> Verdict {
+        self.property = Some(key);
         self
     }
 

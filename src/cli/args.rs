@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 
 use verdem::analysis::cg::{self, Series};
-use verdem::analysis::report::Report;
+use verdem::analysis::report::{Diagnosis, Report};
 use verdem::analysis::Verdict;
 use verdem::case::Case;
 use verdem::contact::named;
@@ -72,8 +72,21 @@ impl Reports {
         verdicts: &[Verdict],
         result: impl Fn(&Verdict) -> String,
     ) -> anyhow::Result<()> {
+        self.write_diagnosed(suite, verdicts, result, Vec::new())
+    }
+
+    /// As [`Reports::write`], the JSON report also carrying `diagnosis`, the failed verdicts
+    /// by the property they test (absent when empty).
+    pub fn write_diagnosed(
+        &self,
+        suite: &str,
+        verdicts: &[Verdict],
+        result: impl Fn(&Verdict) -> String,
+        diagnosis: Vec<Diagnosis>,
+    ) -> anyhow::Result<()> {
         if self.junit.is_some() || self.json.is_some() {
             Report::new(suite, verdicts, result)
+                .diagnosed(diagnosis)
                 .write(self.junit.as_deref(), self.json.as_deref())?;
         }
         Ok(())

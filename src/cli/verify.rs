@@ -1,6 +1,7 @@
 //! `verdem verify`: run the verification cases (and the peers' binary collisions) and print
-//! expected, measured, tolerance and PASS/FAIL; with `--code`, run the prescribed-motion cases
-//! through an external program instead.
+//! expected, measured, tolerance and PASS/FAIL, and after them, when rows failed, the
+//! property each failed row tests; with `--code`, run the prescribed-motion cases through an
+//! external program instead.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -10,7 +11,7 @@ use verdem::contact::Tangential;
 use verdem::peers::motion::MotionPeer;
 use verdem::peers::{self, Peer};
 use verdem::verify::driver::External;
-use verdem::verify::{self, Subject};
+use verdem::verify::{self, diagnosis, Subject};
 
 use super::args::described;
 use super::Finished;
@@ -146,8 +147,15 @@ pub fn exec(a: Args) -> anyhow::Result<Finished> {
             String::new()
         }
     );
-    a.reports
-        .write("verdem verify", &rows, |r| verify::result(r).into())?;
+    // the failed rows by the property they test; nothing when every row passed
+    let diagnosis = diagnosis::diagnose(&rows);
+    print!("{}", diagnosis.summary());
+    a.reports.write_diagnosed(
+        "verdem verify",
+        &rows,
+        |r| verify::result(r).into(),
+        diagnosis.report(),
+    )?;
     Ok(if failed > 0 {
         Finished::ChecksFailed
     } else {

@@ -20,6 +20,7 @@
 //! along t × n, below the cap for every convention (fn = kn·δ − γn·vn, Ft = −kt·ξ − γt·slip
 //! while sticking, `src/contact/normal.rs`, `tangential/cap.rs`).
 
+use super::diagnosis::{Property, Tests};
 use super::objectivity::{spin_sphere_2, tangent_axis};
 use super::{row, row_abs, Row, Subject};
 use crate::case::Case;
@@ -135,46 +136,55 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                     slip_arm,
                     p.f[1].dot(&along) / (0.5 * limit),
                     arm_tol,
-                ),
-                row(&name, "fn / (kn delta)", 1.0, p.fn_signed / fn0, 1e-9),
+                )
+                .tests(Property::Stiffness),
+                row(&name, "fn / (kn delta)", 1.0, p.fn_signed / fn0, 1e-9)
+                    .tests(Property::NormalForce),
                 row(
                     &name,
                     "fn / (F2.n)",
                     1.0,
                     p.fn_signed / p.f[1].dot(&n),
                     1e-9,
-                ),
-                row(&name, "ft / |F2 - (F2.n) n|", 1.0, p.ft / ft, 1e-9),
+                )
+                .tests(Property::ForcesFile),
+                row(&name, "ft / |F2 - (F2.n) n|", 1.0, p.ft / ft, 1e-9)
+                    .tests(Property::ForcesFile),
                 row_abs(
                     &name,
                     "|F1 + F2| / |F2|",
                     0.0,
                     (p.f[0] + p.f[1]).norm() / p.f[1].norm(),
                     1e-12,
-                ),
+                )
+                .tests(Property::ForcesFile),
                 row(
                     &name,
                     "T1.t / (l1 |Ft|)",
                     -torque_arm[0],
                     p.torque[0].dot(&t) / (lever[0] * ft),
                     arm_tol,
-                ),
+                )
+                .tests(Property::Torques),
                 row(
                     &name,
                     "T2.t / (l2 |Ft|)",
                     -torque_arm[1],
                     p.torque[1].dot(&t) / (lever[1] * ft),
                     arm_tol,
-                ),
+                )
+                .tests(Property::Torques),
                 row_abs(&name, "|T1 + T2 + r x F2| / (d |Ft|)", 0.0, balance, 1e-9)
-                    .gating_if(subject.properties.conserves_angular_momentum),
+                    .gating_if(subject.properties.conserves_angular_momentum)
+                    .tests(Property::AngularMomentum),
                 row_abs(
                     &name,
                     "|Ft| unloaded / peak |Ft|",
                     0.0,
                     ft2(&f[f.len() - 1], n) / ft,
                     1e-9,
-                ),
+                )
+                .tests(Property::ClosedCycleEnergy),
             ]
         }
         "coulomb limit" => {
@@ -189,14 +199,16 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                     1.0,
                     ft2(&f[sliding], n) / limit,
                     1e-9,
-                ),
+                )
+                .tests(Property::CoulombCap),
                 row_abs(
                     &name,
                     "|Ft| / (mu fn) back by mu fn/kt",
                     slip_arm - 1.0,
                     ft2(&f[f.len() - 1], n) / limit,
                     arm_tol,
-                ),
+                )
+                .tests(Property::CoulombCap),
             ]
         }
         "dashpots" => {
@@ -265,22 +277,26 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                     1.0,
                     -f[gone].delta / delta,
                     1e-9,
-                ),
-                row_abs(&name, "max |F| apart / (mu fn)", 0.0, apart / limit, 1e-12),
+                )
+                .tests(Property::ForcesFile),
+                row_abs(&name, "max |F| apart / (mu fn)", 0.0, apart / limit, 1e-12)
+                    .tests(Property::ResetAtLoss),
                 row(
                     &name,
                     "fn back / (kn delta)",
                     1.0,
                     last.fn_signed / fn0,
                     1e-9,
-                ),
+                )
+                .tests(Property::NormalForce),
                 row_abs(
                     &name,
                     "|Ft| back / (mu fn)",
                     0.0,
                     ft2(last, n) / limit,
                     1e-9,
-                ),
+                )
+                .tests(Property::ResetAtLoss),
             ]
         }
     })

@@ -23,6 +23,7 @@
 
 use nalgebra::UnitQuaternion;
 
+use super::diagnosis::{Property, Tests};
 use super::driver::{MotionDriver, OWN};
 use super::objectivity::{rigid_rotation, spin_sphere_2, tangent_axis};
 use super::ratchet::net_work;
@@ -242,7 +243,8 @@ pub fn cycle_rows(base: &Case, subject: &Subject, variant: &str) -> anyhow::Resu
             c.residual / force,
             force_round_off,
         )
-        .gating_if(objective),
+        .gating_if(objective)
+        .tests(Property::ClosedCycleEnergy),
         row_abs(
             &name,
             "net work / (kn delta2^2 / 2)",
@@ -250,18 +252,22 @@ pub fn cycle_rows(base: &Case, subject: &Subject, variant: &str) -> anyhow::Resu
             c.work / energy,
             work_round_off,
         )
-        .gating_if(objective && torques_conjugate_to_slip(conv)),
+        .gating_if(objective && torques_conjugate_to_slip(conv))
+        .tests(Property::ClosedCycleEnergy),
     ];
     let factor = theory_factor(conv, rotation);
     if factor > 0.0 {
         // higher orders: O(θ²) = 1e-2 of the rigid rotation's chord and frame
-        rows.push(super::row(
-            &name,
-            "residual / (c kt theta |d delta|)",
-            1.0,
-            c.residual / (factor * force),
-            1e-2,
-        ));
+        rows.push(
+            super::row(
+                &name,
+                "residual / (c kt theta |d delta|)",
+                1.0,
+                c.residual / (factor * force),
+                1e-2,
+            )
+            .tests(Property::ClosedCycleEnergy),
+        );
     }
     Ok(rows)
 }

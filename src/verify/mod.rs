@@ -15,12 +15,16 @@
 //! - [`mindlin_histories`]: held tangential displacement under a changing overlap, closed cycles
 //!   of normal and tangential load (net work), rigid rotations, per Mindlin convention.
 //!
+//! Each prescribed-motion row declares the property of a contact law it tests
+//! ([`diagnosis::Property`]): the summary after the table maps the failed rows to them.
+//!
 //! The table is a list of named [`Entry`]s, selected by name before any of them runs. The
 //! prescribed-motion cases (objectivity, ratchet, histories) drive their contact through a
 //! [`driver::MotionDriver`]: verdem's own law, or an external program ([`code_entries`]).
 
 pub mod collision;
 pub mod conservation;
+pub mod diagnosis;
 pub mod driver;
 pub mod extremes;
 pub mod histories;
@@ -220,11 +224,18 @@ impl MotionCase {
     /// is held to verdem's number of that convention where that convention misses the
     /// expected value (the quantity then ends in `= verdem NAME`). For a subject that
     /// [`Subject::refines`], the rows it fails at the motion's step are judged again by
-    /// [`refinement`] (the same motion at dt/2 and dt/4, verdem's numbers too).
+    /// [`refinement`] (the same motion at dt/2 and dt/4, verdem's numbers too), but for
+    /// the rows of a property without a discretisation to choose
+    /// ([`diagnosis::Property::refines`]).
     pub fn judge(&self, dir: &Path, subject: &Subject, variant: &str) -> anyhow::Result<Vec<Row>> {
         let base = Case::load_for_prescribed_motion(&dir.join(self.file))?;
         let rows = self.judge_at(&base, subject, variant, 1)?;
-        let refine = |r: &Row| r.gate && r.failed() && !is_error(r);
+        let refine = |r: &Row| {
+            r.gate
+                && r.failed()
+                && !is_error(r)
+                && diagnosis::property(r).is_none_or(diagnosis::Property::refines)
+        };
         if !subject.refines || !rows.iter().any(refine) {
             return Ok(rows);
         }
@@ -295,7 +306,10 @@ impl MotionCase {
                         other => other,
                     };
                     let quantity = format!("{} = verdem {}", r.quantity, conv.name());
-                    Verdict::judge(&r.case, &quantity, r.measured, limit)
+                    Verdict {
+                        property: r.property,
+                        ..Verdict::judge(&r.case, &quantity, r.measured, limit)
+                    }
                 };
             }
         }

@@ -12,6 +12,7 @@
 
 use nalgebra::{Rotation3, Unit, UnitQuaternion};
 
+use super::diagnosis::{Property, Tests};
 use super::driver::MotionDriver;
 use super::{row_abs, Row, Subject};
 use crate::case::Case;
@@ -141,7 +142,12 @@ pub fn axis_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Result<
     let case = subject.case(base);
     let [dfn, dft, dir] = drifts(&case, axis(n0, label), subject.driver)?;
     let name = case_name(&subject.label, label);
-    let gate = |r: Row| r.gating_if(subject.properties.objective);
+    // about a tangent axis the normal tilts only; the other axes twist the pair about it
+    let property = match label {
+        "tangent axis" => Property::Objectivity,
+        _ => Property::SpringTwist,
+    };
+    let gate = |r: Row| r.gating_if(subject.properties.objective).tests(property);
     Ok(vec![
         gate(row_abs(&name, "Fn drift per rad", 0.0, dfn, 1e-6)),
         gate(row_abs(&name, "|Ft| drift per rad", 0.0, dft, 1e-6)),

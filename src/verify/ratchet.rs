@@ -16,6 +16,7 @@
 
 use nalgebra::{Unit, UnitQuaternion};
 
+use super::diagnosis::{Property, Tests};
 use super::driver::MotionDriver;
 use super::objectivity::{rigid_rotation, tangent_axis};
 use super::{row_abs, Row, Subject};
@@ -136,7 +137,10 @@ pub fn rotation_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Res
     let c = cycle(&case, axis, overlap, dx, subject.driver)?;
     let energy = c.peak * c.peak / (2.0 * case.contact.kt);
     let name = case_name(&subject.label, label);
-    let gate = |r: Row| r.gating_if(subject.properties.objective);
+    let gate = |r: Row| {
+        r.gating_if(subject.properties.objective)
+            .tests(Property::ClosedCycleEnergy)
+    };
     let (res, work) = (c.residual / c.peak, c.work / energy);
     let mut rows = vec![
         gate(row_abs(&name, "residual |Ft| / peak |Ft|", 0.0, res, 1e-6)),
@@ -153,13 +157,16 @@ pub fn rotation_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Res
     // load.
     if !subject.properties.twists_spring && label == "rotation about n" {
         let twice = cycle(&case, axis, 2.0 * overlap, dx, subject.driver)?;
-        rows.push(row_abs(
-            &name,
-            "load exponent of the residual (fn x2)",
-            0.0,
-            (twice.residual / c.residual).log2(),
-            0.05,
-        ));
+        rows.push(
+            row_abs(
+                &name,
+                "load exponent of the residual (fn x2)",
+                0.0,
+                (twice.residual / c.residual).log2(),
+                0.05,
+            )
+            .tests(Property::SpringTwist),
+        );
     }
     Ok(rows)
 }

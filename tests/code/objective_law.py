@@ -22,6 +22,7 @@ in the middle of the overlap. Its time discretisation is a choice, as in any cod
     twist    the spring follows the tilt of the normal but not the twist about it
     cap      the spring is not reset to the cap while sliding (wound past it)
     kt       the tangential stiffness is 1.0001 times the case's
+    reset    the spring is kept when the contact is lost (and used when it closes again)
 """
 
 import argparse
@@ -91,7 +92,7 @@ def main():
     p.add_argument("--out", required=True)
     p.add_argument("--increment", choices=["positions", "trapezoid"], default="positions")
     p.add_argument("--twist", choices=["quaternions", "spins"], default="quaternions")
-    p.add_argument("--defect", choices=["frame", "twist", "cap", "kt"])
+    p.add_argument("--defect", choices=["frame", "twist", "cap", "kt", "reset"])
     a = p.parse_args()
     with open(a.case, "rb") as f:
         case = tomllib.load(f)
@@ -113,7 +114,8 @@ def main():
         d = norm(r)
         delta = r1 + r2 - d
         if delta <= 0.0:
-            xi, n_old = [0.0, 0.0, 0.0], None  # contact lost: the history is forgotten
+            if a.defect != "reset":
+                xi, n_old = [0.0, 0.0, 0.0], None  # contact lost: the history is forgotten
             out.append([row[0]] + [0.0] * 12 + [delta, 0.0, 0.0])
             continue
         n = scale(1.0 / d, r)
