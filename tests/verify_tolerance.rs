@@ -87,7 +87,10 @@ fn a_law_with_mu_off_by_a_tenth_of_a_percent_fails_the_coulomb_rows_of_every_con
     let rows = verdem::verify::oblique::rows_against(&case, &wrong).unwrap();
     let n = count(&rows, impulse, "");
     // 3 sliding incidences and a spin-only slide per convention
-    assert_eq!(n, 4 * verdem::contact::Tangential::with_constant_kt().count());
+    assert_eq!(
+        n,
+        4 * verdem::contact::Tangential::with_constant_kt().count()
+    );
     assert_eq!(failed(&rows, impulse, "").len(), n, "{rows:#?}");
 }
 

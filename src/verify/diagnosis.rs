@@ -37,11 +37,14 @@ pub enum Property {
     ForcesFile,
     /// A closed cycle without sliding leaves no spring and does no net work.
     ClosedCycleEnergy,
+    /// The dashpots: −γn·vn along n and −γt times the slip rate in the tangent plane, at the
+    /// velocities of the motion, beside the springs.
+    Dashpots,
 }
 
 impl Property {
     /// Every property, in the order of the summary: each after those it is measured through.
-    pub const ALL: [Property; 10] = [
+    pub const ALL: [Property; 11] = [
         Property::Objectivity,
         Property::SpringTwist,
         Property::Stiffness,
@@ -52,6 +55,7 @@ impl Property {
         Property::AngularMomentum,
         Property::ForcesFile,
         Property::ClosedCycleEnergy,
+        Property::Dashpots,
     ];
 
     /// Its key: the reports' word for it and the anchor of its section in
@@ -68,6 +72,7 @@ impl Property {
             Property::Torques => "torques",
             Property::AngularMomentum => "angular-momentum",
             Property::ForcesFile => "forces-file",
+            Property::Dashpots => "dashpots",
         }
     }
 
@@ -84,6 +89,7 @@ impl Property {
             Property::Torques => "torques",
             Property::AngularMomentum => "angular momentum",
             Property::ForcesFile => "the forces file's columns",
+            Property::Dashpots => "the dashpots",
         }
     }
 
@@ -128,6 +134,10 @@ impl Property {
             Property::ForcesFile => {
                 "the columns delta, fn, ft or F1 = -F2 do not agree with the force vectors and \
                  the positions"
+            }
+            Property::Dashpots => {
+                "a dashpot is not gamman*vn along n or gammat times the slip rate at the \
+                 contact point (missing, scaled by a mass, or stored in the spring)"
             }
         }
     }

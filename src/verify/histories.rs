@@ -248,14 +248,16 @@ pub fn history_rows(base: &Case, subject: &Subject, label: &str) -> anyhow::Resu
                     1.0,
                     (f[pressing].fn_signed - f[pressed].fn_signed) / (c.gamman * u),
                     1e-9,
-                ),
+                )
+                .tests(Property::Dashpots),
                 row(
                     &name,
                     "(Ft spinning - Ft held) / (gammat l2 omega)",
                     slip_arm,
                     (along_t(spinning) - along_t(spun)) / (c.gammat * arm * omega),
                     arm_tol,
-                ),
+                )
+                .tests(Property::Dashpots),
             ]
         }
         _ => {

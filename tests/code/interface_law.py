@@ -7,9 +7,13 @@ with a Coulomb slider, objective (plain Python 3.11 or later, no packages).
 
 Its choices, each within the freedom the page gives:
 
-- time discretisation: a step's velocities and turns from the positions and quaternions of
-  its two rows (the rotation vector of q(k) q(k-1)^-1, its angle from atan2); the slip is
-  taken at the row's own normal;
+- time discretisation: the velocities and spins of the row itself (the motion's own), the
+  twist from the quaternions of the step's two rows (the rotation vector of q(k) q(k-1)^-1,
+  its angle from atan2); the slip is taken at the row's own normal. With `--velocities
+  positions`, the step's velocities and spins come from its two rows' positions and
+  quaternions instead, still with the slip at the row's normal: a first-order scheme with a
+  large error that the page says passes by convergence, within the extrapolation's
+  uncertainty;
 - frame: the stored spring is projected onto the new tangent plane and given back its length
   (the tilt), then turned about the normal by the mean of the two spheres' turns about it
   (the twist);
@@ -97,6 +101,15 @@ class Sphere:
         self.v = V(*cols[7:10])
         self.w = V(*cols[10:13])
 
+    def stepped(self, before, turn, dt):
+        """This sphere with the velocity and spin of the step from `before`, `dt` earlier,
+        over which it turned by `turn` (a rotation vector)."""
+        s = Sphere([0.0] * 13)
+        s.x, s.q = self.x, self.q
+        s.v = (self.x - before.x) * (1.0 / dt)
+        s.w = turn * (1.0 / dt)
+        return s
+
 
 class Contact:
     """The law of one contact and its history, the stored spring."""
@@ -158,6 +171,7 @@ def main():
     p.add_argument("case")
     p.add_argument("motion")
     p.add_argument("--out", required=True)
+    p.add_argument("--velocities", choices=["rows", "positions"], default="rows")
     args = p.parse_args()
     with open(args.case, "rb") as f:
         case = tomllib.load(f)
@@ -172,11 +186,14 @@ def main():
         t = cols[0]
         a, b = Sphere(cols[1:14]), Sphere(cols[14:27])
         dt, turn_a, turn_b = 0.0, ZERO, ZERO
+        row = (t, a, b)
         if previous is not None:
             t0, a0, b0 = previous
             dt = t - t0
             turn_a, turn_b = turn_between(a.q, a0.q), turn_between(b.q, b0.q)
-        previous = (t, a, b)
+            if args.velocities == "positions":
+                a, b = a.stepped(a0, turn_a, dt), b.stepped(b0, turn_b, dt)
+        previous = row
         f1, t1, f2, t2, delta, fn, ft = contact.forces(a, b, dt, turn_a, turn_b)
         out.append([t, *f1.values(), *t1.values(), *f2.values(), *t2.values(), delta, fn, ft])
     with open(args.out, "w") as f:
