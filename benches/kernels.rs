@@ -53,6 +53,8 @@ fn pair_kernel(c: &mut Criterion) {
         r: Vec3::new(0.1, 0.2, 0.97),
         rad_p: 0.5,
         rad_i: 0.5,
+        inv_mass_p: 1.0 / std::f64::consts::FRAC_PI_6,
+        inv_mass_i: 1.0 / std::f64::consts::FRAC_PI_6,
         v_p: Vec3::new(0.3, -0.1, -0.2),
         v_i: Vec3::new(-0.1, 0.0, 0.1),
         w_p: Vec3::new(1.0, 0.5, -0.2),

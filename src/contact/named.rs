@@ -7,6 +7,7 @@ use std::sync::LazyLock;
 
 use serde::de::Error as _;
 
+use super::normal_laws::Reads;
 use super::{Normal, Tangential};
 use crate::case::{self, Case, CaseError};
 
@@ -44,9 +45,92 @@ impl Normal {
     }
 }
 
-/// Refuses a case whose normal law or tangential convention no registry holds.
+impl Normal {
+    /// The normal law `case` names, refusing a case that does not give the numbers the law
+    /// reads ([`Normal::reads`]), or gives numbers of a normal law that it leaves unread: the
+    /// error at the `contact.normal` line (the `[contact]` header's for a missing key).
+    pub fn checked(case: &Case) -> Result<Normal, CaseError> {
+        let normal = Normal::of(&case.contact)?;
+        let c = &case.contact;
+        let named = &c.normal;
+        let (file, line) = if named.line > 0 {
+            (named.file.clone(), named.line)
+        } else {
+            (c.given.file.clone(), c.given.line)
+        };
+        let refuse = |msg: String| CaseError {
+            file: file.clone(),
+            line,
+            field: "contact.normal".into(),
+            msg: format!("the normal law `{}` {msg}", normal.name()),
+        };
+        let missing = |key: &str, what: &str| CaseError {
+            file: c.given.file.clone(),
+            line: c.given.line,
+            field: format!("contact.{key}"),
+            msg: format!(
+                "missing field `{key}` ({what}, which the normal law `{}` reads)",
+                normal.name()
+            ),
+        };
+        let reads = normal.reads();
+        let elastic = case.material.elastic().is_some();
+        if reads.contains(&Reads::Elastic) {
+            if !elastic {
+                return Err(refuse(
+                    "builds its spring from the materials' elastic constants: material.youngs \
+                     and material.poisson expected"
+                        .into(),
+                ));
+            }
+            if c.given.has("kn") {
+                return Err(refuse(
+                    "builds its spring from material.youngs and material.poisson and does not \
+                     read contact.kn: remove it"
+                        .into(),
+                ));
+            }
+        }
+        if reads.contains(&Reads::Kn) && !c.given.has("kn") {
+            return Err(missing("kn", "a linear spring's stiffness"));
+        }
+        let optional = [
+            (
+                Reads::Gamman,
+                "gamman",
+                c.given.has("gamman"),
+                "its absolute dashpot, 0 for none",
+            ),
+            (
+                Reads::Restitution,
+                "restitution",
+                c.restitution.is_some(),
+                "the restitution coefficient its damping aims at",
+            ),
+            (
+                Reads::DissipativeConstant,
+                "dissipative_constant",
+                c.dissipative_constant.is_some(),
+                "its dissipative constant A",
+            ),
+        ];
+        for (read, key, given, what) in optional {
+            match (reads.contains(&read), given) {
+                (true, false) => return Err(missing(key, what)),
+                (false, true) => {
+                    return Err(refuse(format!("does not read contact.{key}: remove it")))
+                }
+                _ => {}
+            }
+        }
+        Ok(normal)
+    }
+}
+
+/// Refuses a case whose normal law or tangential convention no registry holds, or that does not
+/// give the numbers its normal law reads ([`Normal::checked`]).
 fn resolves(case: Case) -> Result<Case, CaseError> {
-    Normal::of(&case.contact)?;
+    Normal::checked(&case)?;
     Tangential::of(&case.contact)?;
     Ok(case)
 }

@@ -224,6 +224,10 @@ mod tests {
                 kt: 1000.0,
                 gammat: 5.0,
                 mu: 0.3,
+                e_star: 0.0,
+                g_star: 0.0,
+                restitution: 1.0,
+                dissipative_constant: 0.0,
             };
             let missing = t.with_model(&params, Unaccounted { steps: 500 });
             assert!(

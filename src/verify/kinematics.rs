@@ -131,7 +131,7 @@ impl LawVisitor for Boxed {
 
 /// The contact law of `case`; an error when the case names no tangential convention.
 pub fn law_of(case: &Case) -> Result<Box<dyn DynLaw>, crate::case::CaseError> {
-    engine::with_law(&case.contact, Boxed)
+    engine::with_law(case, Boxed)
 }
 
 /// The two spheres' starting positions and radii, from the case's `spheres` scene (an error
@@ -218,6 +218,8 @@ pub fn drive(
             r: row.x[1] - row.x[0],
             rad_p: radius[1],
             rad_i: radius[0],
+            inv_mass_p: 0.0,
+            inv_mass_i: 0.0,
             v_p: v[1],
             v_i: v[0],
             w_p: w[1],

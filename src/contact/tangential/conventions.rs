@@ -52,6 +52,8 @@ mod tests {
             r: Vec3::new(0.0, 0.0, 0.999),
             rad_p: 0.5,
             rad_i: 0.5,
+            inv_mass_p: 0.0,
+            inv_mass_i: 0.0,
             v_p: Vec3::new(vt, 0.0, 0.0),
             v_i: Vec3::zeros(),
             w_p: Vec3::zeros(),

@@ -197,6 +197,8 @@ pub(crate) fn test_kinematics(r: Vec3, v_p: Vec3, w_p: Vec3, w_i: Vec3) -> PairK
         r,
         rad_p: 0.5,
         rad_i: 0.5,
+        inv_mass_p: 0.0,
+        inv_mass_i: 0.0,
         v_p,
         v_i: Vec3::zeros(),
         w_p,
