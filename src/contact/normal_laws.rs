@@ -115,6 +115,7 @@ normal_laws! {
     HertzTsuji = "hertz-tsuji", mod tsuji, reads [Elastic, Restitution],
         |p| Damped { spring: hertz::Hertz { e_star: p.e_star }, damping: tsuji::Tsuji::new(p.restitution) },
         "Hertz spring, Tsuji's dashpot alpha(e) sqrt(m* fn/delta) from contact.restitution (Tsuji et al. 1992; LAMMPS `damping tsuji`)";
+    HertzViscoelastic = "hertz-viscoelastic", mod viscoelastic, reads [Elastic, DissipativeConstant], |p| Damped { spring: hertz::Hertz { e_star: p.e_star }, damping: viscoelastic::Viscoelastic { a: p.dissipative_constant } }, "Hertz spring, Brilliantov et al.'s viscoelastic dashpot A dF/ddelta = 2 A E* sqrt(R* delta), A from contact.dissipative_constant (Brilliantov et al. 1996)";
 }
 
 #[cfg(test)]
