@@ -9,7 +9,9 @@
 //!   2008), per convention;
 //! - [`histories`]: the tangential spring loaded and unloaded, taken to the Coulomb limit and
 //!   back, and reset when the contact opens, per convention;
-//! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster.
+//! - [`conservation`]: energy and momentum of a periodic gas, angular momentum of a cluster;
+//! - [`hertz_impact`]: Hertz head-on impacts against Johnson's closed forms, and the
+//!   restitution of the dampings set from one.
 //!
 //! The table is a list of named [`Entry`]s, selected by name before any of them runs. The
 //! prescribed-motion cases (objectivity, ratchet, histories) drive their contact through a
@@ -19,6 +21,7 @@ pub mod collision;
 pub mod conservation;
 pub mod driver;
 pub mod extremes;
+pub mod hertz_impact;
 pub mod histories;
 pub mod kinematics;
 pub mod mcnamara;
@@ -361,6 +364,10 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
     list.push(Entry::new(conservation.chain(clusters), move || {
         conservation::rows(&load("conservation.toml")?, 1_000_000)
     }));
+    list.push(Entry::new(
+        ["hertz", "hertz-restitution", "hertz-tsuji"],
+        move || hertz_impact::rows(&load("hertz_impact.toml")?),
+    ));
     list
 }
 
