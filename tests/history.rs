@@ -50,7 +50,7 @@ impl ContactLaw for AgingLaw {
             ..PairForce::default()
         }
     }
-    fn stored_energy(&self, delta: f64, _: &Aged) -> f64 {
+    fn stored_energy(&self, delta: f64, _r_star: f64, _: &Aged) -> f64 {
         0.5 * self.kn * delta * delta
     }
 }

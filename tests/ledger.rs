@@ -149,8 +149,8 @@ impl ContactLaw for Misreporting {
     fn evaluate(&self, k: &PairKinematics, h: &mut Vec3, dt: f64) -> PairForce {
         self.law.evaluate(k, h, dt)
     }
-    fn stored_energy(&self, delta: f64, h: &Vec3) -> f64 {
-        self.law.stored_energy(delta, h)
+    fn stored_energy(&self, delta: f64, r_star: f64, h: &Vec3) -> f64 {
+        self.law.stored_energy(delta, r_star, h)
     }
     const SPLITS_DISSIPATION: bool = true;
     fn evaluate_dissipating(
@@ -179,8 +179,8 @@ impl ContactLaw for Unsplit {
     fn evaluate(&self, k: &PairKinematics, h: &mut Vec3, dt: f64) -> PairForce {
         self.0.evaluate(k, h, dt)
     }
-    fn stored_energy(&self, delta: f64, h: &Vec3) -> f64 {
-        self.0.stored_energy(delta, h)
+    fn stored_energy(&self, delta: f64, r_star: f64, h: &Vec3) -> f64 {
+        self.0.stored_energy(delta, r_star, h)
     }
 }
 

@@ -289,7 +289,7 @@ fn a_peer_without_inrun_dumps_and_intervals_that_do_not_divide_are_refused() {
         cross_inrun(
             peers::by_name(peer).unwrap(),
             &case,
-            verdem::contact::Tangential::of(&case.contact).unwrap(),
+            verdem::contact::Tangential::of(&case).unwrap(),
             &state,
             2000,
             200,

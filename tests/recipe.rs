@@ -78,7 +78,7 @@ fn the_documented_recipes_add_a_tangential_convention_and_a_damping_that_verify_
     let docs = std::fs::read_to_string(root.join("docs/extending.md")).unwrap();
     for form in [
         "Variant = \"name\", |p| Model::new(p.kt, p.gammat, p.mu), [properties], \"one-line description\";",
-        "Variant = \"name\", mod FILE, |p| FILE::Model { kn: p.kn, gamman: p.gamman }, \"one-line description\";",
+        "Variant = \"name\", mod FILE, reads [Kn, Gamman], |p| Damped { spring: Linear { kn: p.kn }, damping: FILE::Model { gamman: p.gamman } }, \"one-line description\";",
         "`src/contact/normal_laws/FILE.rs`",
     ] {
         assert!(docs.contains(form), "docs/extending.md no longer gives {form}");

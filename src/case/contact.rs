@@ -10,9 +10,13 @@ use super::CaseError;
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Contact {
-    /// Normal spring stiffness (force/length).
+    /// Normal spring stiffness (force/length) of a linear spring; not given for a law built
+    /// from elastic constants (read as 0; [`Contact::given`] says whether it was).
+    #[serde(default)]
     pub kn: f64,
-    /// Absolute normal damping (mass/time).
+    /// Absolute normal damping (mass/time); read as 0 when not given, which the laws that read
+    /// it refuse ([`Contact::given`]).
+    #[serde(default)]
     pub gamman: f64,
     /// Tangential spring stiffness (force/length).
     #[serde(default)]
@@ -34,6 +38,38 @@ pub struct Contact {
     /// Clip the attractive tail of the normal force, fn = max(fn, 0) (default false).
     #[serde(default)]
     pub clip_normal: bool,
+    /// Normal restitution coefficient (in (0, 1]) of the dampings set from one.
+    #[serde(default)]
+    pub restitution: Option<f64>,
+    /// Brilliantov et al.'s dissipative constant A (time, >= 0) of the viscoelastic damping.
+    #[serde(default)]
+    pub dissipative_constant: Option<f64>,
+    /// The keys the case's `[contact]` table sets, as read.
+    #[serde(skip)]
+    pub given: Given,
+}
+
+/// The keys a table of the case sets, as read, and where the table begins (file, 1-based line
+/// of its header; 0 unknown), for the checks of which numbers a law reads; not part of the
+/// case's value: two cases are equal whichever keys spell them.
+#[derive(Clone, Debug, Default)]
+pub struct Given {
+    pub keys: Vec<String>,
+    pub file: String,
+    pub line: usize,
+}
+
+impl Given {
+    /// Whether the key `key` is set.
+    pub fn has(&self, key: &str) -> bool {
+        self.keys.iter().any(|k| k == key)
+    }
+}
+
+impl PartialEq for Given {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 fn default_tangential() -> Convention {
@@ -107,16 +143,28 @@ impl<'de> Deserialize<'de> for Convention {
 }
 
 impl Contact {
-    /// kn > 0; gamman, kt, gammat, mu >= 0; kt > 0 with friction.
+    /// kn > 0 when given; gamman, kt, gammat, mu >= 0; restitution in
+    /// (0, 1] and dissipative_constant >= 0 when given.
     pub(super) fn check(&self, at: &Locator<'_>) -> Result<(), CaseError> {
-        at.positive("contact.kn", self.kn)?;
+        if self.given.has("kn") {
+            at.positive("contact.kn", self.kn)?;
+        }
+        if let Some(e) = self.restitution {
+            if !(e > 0.0 && e <= 1.0) {
+                return Err(at.error(
+                    "contact.restitution",
+                    format!("a restitution coefficient in (0, 1] expected, got {e}"),
+                ));
+            }
+        }
+        if let Some(a) = self.dissipative_constant {
+            at.non_negative("contact.dissipative_constant", a)?;
+        }
         at.non_negative("contact.gamman", self.gamman)?;
         at.non_negative("contact.kt", self.kt)?;
         at.non_negative("contact.gammat", self.gammat)?;
+        // kt > 0 with friction for the conventions whose spring is kt: contact::named
         at.non_negative("contact.mu", self.mu)?;
-        if self.mu > 0.0 {
-            at.positive("contact.kt", self.kt)?;
-        }
         Ok(())
     }
 }

@@ -89,11 +89,16 @@ impl Case {
     fn parse_for(text: &str, file: &str, purpose: Purpose) -> Result<Case, CaseError> {
         let at = Locator::new(text, file);
         let mut case: Case = toml::from_str(text).map_err(|e| at.parse_error(&e))?;
-        if let Some((field, value)) = toml::from_str::<toml::Value>(text)
-            .ok()
-            .and_then(|v| non_finite(&v, ""))
-        {
+        let value = toml::from_str::<toml::Value>(text).ok();
+        if let Some((field, value)) = value.as_ref().and_then(|v| non_finite(v, "")) {
             return Err(at.error(&field, format!("a finite number expected, got {value}")));
+        }
+        if let Some(toml::Value::Table(t)) = value.as_ref().and_then(|v| v.get("contact")) {
+            case.contact.given = super::Given {
+                keys: t.keys().cloned().collect(),
+                file: file.into(),
+                line: at.line("contact"),
+            };
         }
         case.contact.tangential.file = file.into();
         case.contact.tangential.line = at.line("contact.tangential");

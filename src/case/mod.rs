@@ -26,11 +26,12 @@ mod scene;
 mod time_step;
 mod walls;
 
-pub use contact::{Contact, Convention};
+pub use contact::{Contact, Convention, Given};
+pub use derived::{Stiffness, HERTZ_TC_PER_DELTA};
 pub use domain::DomainSpec;
 pub use guard::{Guard, DEFAULT_GUARD_CONTACT, DEFAULT_GUARD_ENERGY, DEFAULT_GUARD_OVERLAP};
 pub use load::MAX_CASE_BYTES;
-pub use material::Material;
+pub use material::{effective_shear, effective_youngs, Material};
 pub use neighbor::{Neighbor, Search};
 pub use output::Output;
 pub use run::Run;

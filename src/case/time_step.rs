@@ -1,7 +1,7 @@
 //! The time step against the scheme's stability limit for the contacts the scene can have
 //! (`stability`), and the warning about a coarse one.
 
-use super::derived::sphere_volume;
+use super::derived::{sphere_volume, Stiffness};
 use super::locate::Locator;
 use super::{Case, CaseError, Scene};
 use crate::stability::{self, Direction, Limit, Pair, Spring};
@@ -60,6 +60,17 @@ impl Case {
         let per_tc = tc / dt;
         if per_tc >= COARSE_STEPS_PER_COLLISION * (1.0 - 1e-12) {
             return Ok(Vec::new());
+        }
+        if let Stiffness::Hertz { .. } = self.stiffness() {
+            let warning = at.error(
+                field,
+                format!(
+                    "coarse time step, tc/dt = {per_tc:.3} (below {COARSE_STEPS_PER_COLLISION}) \
+                     for Hertz's free–free collision at the largest impact speed \
+                     (`verdem verify`'s Hertz rows measure the error this costs)"
+                ),
+            );
+            return Ok(vec![warning.to_string()]);
         }
         let normal = stability::Spring {
             k: self.contact.kn,
@@ -120,25 +131,85 @@ impl Case {
     }
 
     /// The stability limit of every contact the scene can have ([`Case::pairs`]): normal, and
-    /// tangential when mu > 0.
+    /// tangential when mu > 0. A Hertz spring's normal stiffness is taken at its stiffest, the
+    /// tangent Sn = 2E*√(R*·δmax) at the largest impact speed ([`Case::largest_speed`]) with
+    /// the pair's largest R* ([`Case::hertz_radius`]), the heaviest damping the case's dashpot
+    /// and restitution give it ([`Case::hertz_spring`]).
     pub fn stability_limits(&self) -> Vec<Limit> {
         let c = &self.contact;
-        let normal = Spring {
-            k: c.kn,
-            gamma: c.gamman,
-        };
         let tangential = Spring {
             k: c.kt,
             gamma: c.gammat,
         };
         let mut limits = Vec::new();
         for (pair, meff) in self.pairs() {
+            let normal = match self.stiffness() {
+                Stiffness::Linear { kn } => Spring {
+                    k: kn,
+                    gamma: c.gamman,
+                },
+                Stiffness::Hertz { e_star } => self.hertz_spring(pair, meff, e_star),
+            };
             limits.push(Limit::of(pair, Direction::Normal, meff, normal));
             if c.mu > 0.0 {
                 limits.push(Limit::of(pair, Direction::Tangential, meff, tangential));
             }
         }
         limits
+    }
+
+    /// The linear spring that stands for a Hertz contact of kind `pair` (effective mass `meff`,
+    /// modulus `e_star`) at its stiffest: k = Sn = 2E*√(R*·δmax) at the scene's largest impact
+    /// speed and the pair's largest R*, and γ = γn + 2ζ√(k·meff) with ζ = −ln e/√(ln² e + π²)
+    /// for a restitution e (the damping ratio that gives e to a linear spring, for the dampings
+    /// set from one), the larger the damping the smaller the limit (`stability::critical_dt`).
+    pub fn hertz_spring(&self, pair: Pair, meff: f64, e_star: f64) -> Spring {
+        let r_star = self.hertz_radius(pair);
+        let v = self.largest_speed().unwrap_or(0.0);
+        let delta = Case::hertz_delta_max(meff, r_star, e_star, v);
+        // Sn = 2 E* √(R* δ) (Johnson 1985, §4.2)
+        let k = 2.0 * e_star * (r_star * delta).sqrt();
+        let zeta = self.contact.restitution.map_or(0.0, |e| {
+            let ln_e = e.ln();
+            -ln_e / (ln_e * ln_e + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+        });
+        Spring {
+            k,
+            gamma: self.contact.gamman + 2.0 * zeta * (k * meff).sqrt(),
+        }
+    }
+
+    /// The largest effective radius R* = r₁r₂/(r₁ + r₂) (length) of a `pair` contact the scene
+    /// can have: of its two largest free spheres, or of its largest free and largest wall
+    /// sphere (the material's diameter for a sphere without a radius).
+    pub fn hertz_radius(&self, pair: Pair) -> f64 {
+        let d = self.material.diameter;
+        let (mut free, mut wall) = (Vec::new(), Vec::new());
+        if let Scene::Spheres { sphere } = &self.scene {
+            for s in sphere {
+                let r = s.radius.unwrap_or(0.5 * d);
+                if s.fixed {
+                    wall.push(r)
+                } else {
+                    free.push(r)
+                }
+            }
+        }
+        free.sort_by(|a, b| b.total_cmp(a));
+        let big = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.5 * d);
+        let wall_max = wall
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let (r1, r2) = match pair {
+            Pair::FreeFree => (big(&free, 0), big(&free, 1)),
+            Pair::FreeWall => (
+                big(&free, 0),
+                if wall.is_empty() { 0.5 * d } else { wall_max },
+            ),
+        };
+        r1 * r2 / (r1 + r2)
     }
 
     /// The smallest of [`Case::stability_limits`], `None` when the scene has no contact; of

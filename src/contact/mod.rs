@@ -20,7 +20,7 @@ pub mod tangential;
 use crate::state::History;
 pub use crate::state::PairForce;
 use crate::Vec3;
-pub use normal::{LinearSpringDashpot, NormalModel};
+pub use normal::{Damped, Damping, LinearSpringDashpot, NormalModel, Spring};
 pub use normal_laws::{Normal, NormalVisitor};
 pub use parameters::Parameters;
 pub use registry::{Geometry, Properties, Tangential, TangentialVisitor};
@@ -102,7 +102,7 @@ pub struct PairInput {
 
 impl PairInput {
     /// Two spheres of radii `rad_p` and `rad_i` (length) at separation `r` = x_P − x_I
-    /// (minimum image), at rest: what the saves' writers need to find a contact's normal,
+    /// (minimum image), at rest, of no mass named (both inverse masses 0): what the saves' writers need to find a contact's normal,
     /// overlap and contact point exactly as the force pass computed them.
     pub fn at_rest(r: Vec3, rad_p: f64, rad_i: f64) -> PairInput {
         PairInput {
@@ -186,17 +186,19 @@ pub trait ContactLaw: Send + Sync {
     /// Force and torques of a contact, updating its `history` over one time step `dt` (time).
     fn evaluate(&self, k: &PairKinematics, history: &mut Self::History, dt: f64) -> PairForce;
 
-    /// Elastic energy held by a contact of overlap `delta` (length, > 0) and history `history`
-    /// (energy units): what its springs can give back to the particles. The run guard's energy
-    /// balance counts it, so that a packing releasing its springs is not taken for a gain.
-    fn stored_energy(&self, delta: f64, history: &Self::History) -> f64;
+    /// Elastic energy held by a contact of overlap `delta` (length, > 0), effective radius
+    /// `r_star` (R* = r_P·r_I/(r_P + r_I), length; [`PairKinematics::r_star`]) and history
+    /// `history` (energy units): what its springs can give back to the particles. The run
+    /// guard's energy balance counts it, so that a packing releasing its springs is not taken
+    /// for a gain.
+    fn stored_energy(&self, delta: f64, r_star: f64, history: &Self::History) -> f64;
 
-    /// The part of [`ContactLaw::stored_energy`] a function of the overlap `delta` alone
-    /// (length, > 0; energy units): what the normal spring holds and gives back exactly as the
-    /// overlap closes. The run guard's contact accounts count it at every step. By default the
-    /// energy held with a fresh history.
-    fn normal_energy(&self, delta: f64) -> f64 {
-        self.stored_energy(delta, &Self::History::default())
+    /// The part of [`ContactLaw::stored_energy`] a function of the overlap `delta` (length)
+    /// and the effective radius `r_star` (length) alone (energy units): what the normal spring
+    /// holds and gives back exactly as the overlap closes. The run guard's contact accounts
+    /// count it at every step. By default the energy held with a fresh history.
+    fn normal_energy(&self, delta: f64, r_star: f64) -> f64 {
+        self.stored_energy(delta, r_star, &Self::History::default())
     }
 
     /// Whether [`ContactLaw::evaluate_dissipating`] reports the dissipation split by part. False
@@ -238,12 +240,12 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
         self.evaluate_dissipating(k, xi, dt).0
     }
 
-    fn stored_energy(&self, delta: f64, xi: &T::History) -> f64 {
-        self.normal.stored_energy(delta) + self.tangential.stored_energy(xi)
+    fn stored_energy(&self, delta: f64, r_star: f64, xi: &T::History) -> f64 {
+        self.normal.stored_energy(delta, r_star) + self.tangential.stored_energy(xi)
     }
 
-    fn normal_energy(&self, delta: f64) -> f64 {
-        self.normal.stored_energy(delta)
+    fn normal_energy(&self, delta: f64, r_star: f64) -> f64 {
+        self.normal.stored_energy(delta, r_star)
     }
 
     const SPLITS_DISSIPATION: bool = N::SPLITS_DISSIPATION && T::SPLITS_DISSIPATION;
@@ -255,8 +257,8 @@ impl<N: NormalModel, T: TangentialModel> ContactLaw for Composed<N, T> {
         xi: &mut T::History,
         dt: f64,
     ) -> (PairForce, Dissipated) {
-        let fn_signed = self.normal.force(k.delta, k.vn);
-        let normal = self.normal.dissipated(k.delta, k.vn, fn_signed, dt);
+        let fn_signed = self.normal.force(k);
+        let normal = self.normal.dissipated(k, fn_signed, dt);
         if T::ACTIVE {
             let (ft, [tangential, slide]) = self.tangential.force_dissipating(k, fn_signed, xi, dt);
             let f = fn_signed * k.n + ft;

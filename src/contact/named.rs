@@ -7,6 +7,7 @@ use std::sync::LazyLock;
 
 use serde::de::Error as _;
 
+use super::normal_laws::Reads;
 use super::{Normal, Parameters, Tangential};
 use crate::case::{self, Case, CaseError};
 
@@ -31,12 +32,13 @@ impl Tangential {
     /// contact.tangential: unknown variant …` at the line that names it; for a convention with
     /// Mindlin's stiffness ([`crate::contact::Properties::mindlin_stiffness`]) in a case that
     /// gives no elastic constants (G* = 0), the error `… needs the material's youngs and
-    /// poisson` at the same line.
-    pub fn of(contact: &case::Contact) -> Result<Tangential, CaseError> {
-        let named = &contact.tangential;
+    /// poisson` at the same line; for a convention with the case's constant kt, friction
+    /// (mu > 0) with kt = 0 is the error `… contact.kt: must be > 0 with friction …`.
+    pub fn of(case: &Case) -> Result<Tangential, CaseError> {
+        let named = &case.contact.tangential;
         let t = Tangential::named(named.name())
             .ok_or_else(|| unknown(named, "contact.tangential", &NAMES))?;
-        if t.properties().mindlin_stiffness && Parameters::of(contact).g_star <= 0.0 {
+        if t.properties().mindlin_stiffness && Parameters::of(case).g_star <= 0.0 {
             return Err(CaseError {
                 file: named.file.clone(),
                 line: named.line,
@@ -44,6 +46,19 @@ impl Tangential {
                 msg: format!(
                     "`{}` has Mindlin's stiffness 8G*a: it needs the material's youngs and \
                      poisson (the case gives no elastic constants, so G* = 0)",
+                    t.name()
+                ),
+            });
+        }
+        let c = &case.contact;
+        if !t.properties().mindlin_stiffness && c.mu > 0.0 && c.kt <= 0.0 {
+            return Err(CaseError {
+                file: case.path.display().to_string(),
+                line: named.line,
+                field: "contact.kt".into(),
+                msg: format!(
+                    "must be > 0 with friction (mu = {}): `{}` has the case's constant kt",
+                    c.mu,
                     t.name()
                 ),
             });
@@ -61,10 +76,93 @@ impl Normal {
     }
 }
 
-/// Refuses a case whose normal law or tangential convention no registry holds.
+impl Normal {
+    /// The normal law `case` names, refusing a case that does not give the numbers the law
+    /// reads ([`Normal::reads`]), or gives numbers of a normal law that it leaves unread: the
+    /// error at the `contact.normal` line (the `[contact]` header's for a missing key).
+    pub fn checked(case: &Case) -> Result<Normal, CaseError> {
+        let normal = Normal::of(&case.contact)?;
+        let c = &case.contact;
+        let named = &c.normal;
+        let (file, line) = if named.line > 0 {
+            (named.file.clone(), named.line)
+        } else {
+            (c.given.file.clone(), c.given.line)
+        };
+        let refuse = |msg: String| CaseError {
+            file: file.clone(),
+            line,
+            field: "contact.normal".into(),
+            msg: format!("the normal law `{}` {msg}", normal.name()),
+        };
+        let missing = |key: &str, what: &str| CaseError {
+            file: c.given.file.clone(),
+            line: c.given.line,
+            field: format!("contact.{key}"),
+            msg: format!(
+                "missing field `{key}` ({what}, which the normal law `{}` reads)",
+                normal.name()
+            ),
+        };
+        let reads = normal.reads();
+        let elastic = case.material.elastic().is_some();
+        if reads.contains(&Reads::Elastic) {
+            if !elastic {
+                return Err(refuse(
+                    "builds its spring from the materials' elastic constants: material.youngs \
+                     and material.poisson expected"
+                        .into(),
+                ));
+            }
+            if c.given.has("kn") {
+                return Err(refuse(
+                    "builds its spring from material.youngs and material.poisson and does not \
+                     read contact.kn: remove it"
+                        .into(),
+                ));
+            }
+        }
+        if reads.contains(&Reads::Kn) && !c.given.has("kn") {
+            return Err(missing("kn", "a linear spring's stiffness"));
+        }
+        let optional = [
+            (
+                Reads::Gamman,
+                "gamman",
+                c.given.has("gamman"),
+                "its absolute dashpot, 0 for none",
+            ),
+            (
+                Reads::Restitution,
+                "restitution",
+                c.restitution.is_some(),
+                "the restitution coefficient its damping aims at",
+            ),
+            (
+                Reads::DissipativeConstant,
+                "dissipative_constant",
+                c.dissipative_constant.is_some(),
+                "its dissipative constant A",
+            ),
+        ];
+        for (read, key, given, what) in optional {
+            match (reads.contains(&read), given) {
+                (true, false) => return Err(missing(key, what)),
+                (false, true) => {
+                    return Err(refuse(format!("does not read contact.{key}: remove it")))
+                }
+                _ => {}
+            }
+        }
+        Ok(normal)
+    }
+}
+
+/// Refuses a case whose normal law or tangential convention no registry holds, or that does not
+/// give the numbers its normal law reads ([`Normal::checked`]).
 fn resolves(case: Case) -> Result<Case, CaseError> {
-    Normal::of(&case.contact)?;
-    Tangential::of(&case.contact)?;
+    Normal::checked(&case)?;
+    Tangential::of(&case)?;
     Ok(case)
 }
 
@@ -106,10 +204,10 @@ mod tests {
                 &format!("tangential = \"{}\"", t.name()),
             );
             let case = case::Case::parse(&named, "q.toml").unwrap();
-            assert_eq!(Tangential::of(&case.contact).unwrap(), t);
+            assert_eq!(Tangential::of(&case).unwrap(), t);
             let mut set = case.clone();
             set.contact.tangential = t.into();
-            assert_eq!(Tangential::of(&set.contact).unwrap(), t);
+            assert_eq!(Tangential::of(&set).unwrap(), t);
         }
         let bad = text.replace("tangential = \"mercury\"", "tangential = \"nope\"");
         let case = case::Case::parse(&bad, "q.toml").unwrap();
@@ -118,7 +216,7 @@ mod tests {
             .position(|l| l.starts_with("tangential"))
             .unwrap()
             + 1;
-        let e = Tangential::of(&case.contact).unwrap_err().to_string();
+        let e = Tangential::of(&case).unwrap_err().to_string();
         assert!(
             e.starts_with(&format!(
                 "q.toml:{line}: contact.tangential: unknown variant `nope`, expected one of \
@@ -145,7 +243,7 @@ mod tests {
                 &format!("tangential = \"{}\"", t.name()),
             );
             let case = case::Case::parse(&named, "q.toml").unwrap();
-            let e = Tangential::of(&case.contact).unwrap_err().to_string();
+            let e = Tangential::of(&case).unwrap_err().to_string();
             assert!(
                 e.starts_with(&format!(
                     "q.toml:{line}: contact.tangential: `{}`",

@@ -278,6 +278,8 @@ mod tests {
                 mu: 0.3,
                 e_star: 0.0,
                 g_star: 0.0,
+                restitution: 1.0,
+                dissipative_constant: 0.0,
             };
             let missing = t.with_model(&params, Unaccounted { steps: 500 });
             assert!(

@@ -349,7 +349,7 @@ pub fn cross_inrun(
             peer: peer_profiles(peer, &run, &o, &template, s, case.dt())?,
             verdem_as_peer: acc.result().context("verdem: no in-run sample")?,
             verdem: own_profiles(own_case, state, np, s)?,
-            own_convention: Tangential::of(&own_case.contact)?,
+            own_convention: Tangential::of(own_case)?,
         }),
         _ => None,
     };
@@ -388,7 +388,7 @@ pub fn cross_inrun(
     let report = Report {
         peer,
         np,
-        convention: Tangential::of(&case.contact)?,
+        convention: Tangential::of(&case)?,
         saves,
         profiles_chi2,
         inrun,

@@ -93,7 +93,8 @@ pub(super) fn measure<L: ContactLaw>(
         let r = domain.min_image(pt.x[p] - pt.x[i]);
         let delta = pt.radius[p] + pt.radius[i] - r.norm();
         if delta > 0.0 {
-            stored += fixed(law.stored_energy(delta, &pairs.history[k]));
+            let (rp, ri) = (pt.radius[p], pt.radius[i]);
+            stored += fixed(law.stored_energy(delta, rp * ri / (rp + ri), &pairs.history[k]));
         }
     }
     Energy {
@@ -333,7 +334,8 @@ pub(super) fn read<L: ContactLaw>(
         let r_pi = domain.min_image(pt.x[p] - pt.x[i]);
         let delta = pt.radius[p] + pt.radius[i] - r_pi.norm();
         if delta > 0.0 {
-            r.elastic += fixed(law.stored_energy(delta, &pairs.history[k]));
+            let (rp, ri) = (pt.radius[p], pt.radius[i]);
+            r.elastic += fixed(law.stored_energy(delta, rp * ri / (rp + ri), &pairs.history[k]));
         }
         // out.f is the force on P; I receives −out.f.
         let f = pairs.out[k].f;

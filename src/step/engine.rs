@@ -171,20 +171,28 @@ pub trait LawVisitor {
     fn visit<L: ContactLaw + Clone + 'static>(self, law: L) -> Self::Output;
 }
 
-/// Composes the contact law of `c` and hands it to `v`: the normal law the registry builds
-/// (clipped if the case asks), then the tangential convention; an error when `c` names no
-/// normal law ([`Normal::of`]) or no tangential convention ([`Tangential::of`]), with or
-/// without friction. Without friction the law has no tangential history, torque or spin
+/// Composes the contact law of `case` and hands it to `v`: the normal law the registry builds
+/// (clipped if the case asks), then the tangential convention; an error when the case names no
+/// normal law or does not give the numbers it reads ([`Normal::checked`]), or names no
+/// tangential convention ([`Tangential::of`]), with or without friction. Without friction the law has no tangential history, torque or spin
 /// (model only what the case needs).
-pub fn with_law<V: LawVisitor>(c: &case::Contact, v: V) -> Result<V::Output, CaseError> {
-    let normal = Normal::of(c)?;
-    let tangential = Tangential::of(c)?;
-    Ok(normal.with_model(&Parameters::of(c), ClipThen { c, tangential, v }))
+pub fn with_law<V: LawVisitor>(case: &Case, v: V) -> Result<V::Output, CaseError> {
+    let normal = Normal::checked(case)?;
+    let tangential = Tangential::of(case)?;
+    let params = Parameters::of(case);
+    let then = ClipThen {
+        c: &case.contact,
+        params,
+        tangential,
+        v,
+    };
+    Ok(normal.with_model(&params, then))
 }
 
 /// Clips the case's normal model if it asks to, then composes it with its tangential model.
 struct ClipThen<'a, V> {
     c: &'a case::Contact,
+    params: Parameters,
     tangential: Tangential,
     v: V,
 }
@@ -193,25 +201,25 @@ impl<V: LawVisitor> NormalVisitor for ClipThen<'_, V> {
     type Output = V::Output;
     fn visit<N: NormalModel + Clone + 'static>(self, normal: N) -> V::Output {
         if self.c.clip_normal {
-            with_tangential(self.c, self.tangential, Clipped(normal), self.v)
+            with_tangential(&self.params, self.tangential, Clipped(normal), self.v)
         } else {
-            with_tangential(self.c, self.tangential, normal, self.v)
+            with_tangential(&self.params, self.tangential, normal, self.v)
         }
     }
 }
 
-fn with_tangential<N, V>(c: &case::Contact, tangential: Tangential, normal: N, v: V) -> V::Output
+fn with_tangential<N, V>(p: &Parameters, tangential: Tangential, normal: N, v: V) -> V::Output
 where
     N: NormalModel + Clone + 'static,
     V: LawVisitor,
 {
-    if c.mu <= 0.0 {
+    if p.mu <= 0.0 {
         return v.visit(Composed {
             normal,
             tangential: Frictionless,
         });
     }
-    tangential.with_model(&Parameters::of(c), ComposeWith { normal, v })
+    tangential.with_model(p, ComposeWith { normal, v })
 }
 
 /// Composes a normal model with the tangential model the registry builds, for a visitor.
@@ -284,5 +292,5 @@ pub fn build(case: &Case, scene: Scene, o: &Overrides) -> Result<Box<dyn Engine>
         bind: o.bind.unwrap_or(true),
         guard: case.guard,
     };
-    with_law(&case.contact, parts)
+    with_law(case, parts)
 }

@@ -153,7 +153,7 @@ pub(super) unsafe fn contact_breach<L: ContactLaw>(
             return Some(Breach::Overlap { p, i, delta, limit });
         }
         let tally = arr.tally.get(k);
-        let excess = tally.excess(view.law.normal_energy(delta));
+        let excess = tally.excess(view.law.normal_energy(delta, r_star(view, p, i)));
         (tally.open && excess > view.excess * tally.taken).then_some(Breach::Pumped {
             p,
             i,
@@ -359,7 +359,7 @@ unsafe fn opened<L: ContactLaw>(
 #[inline(always)]
 fn book_release<L: ContactLaw>(law: &L, history: &L::History, free: bool, flows: &mut Flows) {
     if L::SPLITS_DISSIPATION && free {
-        let held = law.stored_energy(0.0, history) - law.normal_energy(0.0);
+        let held = law.stored_energy(0.0, 0.0, history) - law.normal_energy(0.0, 0.0);
         flows.dissipated[2] += fixed(held);
     }
 }
@@ -522,8 +522,9 @@ unsafe fn guard_contact<L: ContactLaw>(
     let at = [view.v.get(p), view.v.get(i), view.w.get(p), view.w.get(i)];
     // F_n·(v_(n−½) + v_(n+½))·dt/2: half of each of the two forces at these velocities.
     let work = 0.5 * view.dt * (touch.before.unwrap_or(0.0) + power(out, at));
-    let normal = view.law.normal_energy(touch.delta);
-    let held_now = || view.law.stored_energy(touch.delta, history);
+    let r_star = r_star(view, p, i);
+    let normal = view.law.normal_energy(touch.delta, r_star);
+    let held_now = || view.law.stored_energy(touch.delta, r_star, history);
     let excess = tally.book(work, normal, touch.before.is_none(), held_now);
     if excess > 0.0 {
         watch.pumped = watch.pumped.max(excess / tally.taken);
@@ -537,6 +538,13 @@ unsafe fn guard_contact<L: ContactLaw>(
         return;
     };
     watch.wall_work += super::energy::fixed(power * view.dt);
+}
+
+/// The effective radius R* = r_P·r_I/(r_P + r_I) (length) of pair (p, i).
+#[inline(always)]
+fn r_star<L>(view: &PairView<'_, L>, p: usize, i: usize) -> f64 {
+    let (rp, ri) = (view.radius[p], view.radius[i]);
+    rp * ri / (rp + ri)
 }
 
 /// The overlap r_P + r_I − |x_P − x_I| (length) of pair (p, i); `PERIODIC` false for interior

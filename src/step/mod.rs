@@ -839,7 +839,7 @@ mod tests {
                 search: case.neighbor.search,
                 steps,
             };
-            engine::with_law(&case.contact, run).unwrap();
+            engine::with_law(&case, run).unwrap();
         }
     }
 }

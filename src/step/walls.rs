@@ -93,7 +93,8 @@ impl<H: History> WallSlots<H> {
                 let s = id[a] as usize * count + w;
                 let delta = radius[a] - (x[a] - wall.point).dot(&wall.normal);
                 if self.active[s] && delta > 0.0 {
-                    sum += fixed(law.stored_energy(delta, &self.history[s]));
+                    // a plane's R* is the sphere's radius
+                    sum += fixed(law.stored_energy(delta, radius[a], &self.history[s]));
                 }
             }
         }
@@ -188,7 +189,9 @@ pub(super) unsafe fn wall_chunk<L: ContactLaw>(
             let Some(kin) = input.kinematics() else {
                 if *active {
                     if L::SPLITS_DISSIPATION {
-                        let held = law.stored_energy(0.0, history) - law.normal_energy(0.0);
+                        let rad = arr.radius.get(j);
+                        let held =
+                            law.stored_energy(0.0, rad, history) - law.normal_energy(0.0, rad);
                         watch.flows.dissipated[2] += fixed(held);
                     }
                     *active = false;

@@ -65,6 +65,8 @@ pub struct Outcome {
     pub w: [Vec3; 2],
     pub steps_in_contact: u64,
     pub delta_max: f64,
+    /// The largest normal force (force units) of the contact at the ends of steps.
+    pub fn_max: f64,
     pub dt: f64,
 }
 
@@ -75,6 +77,7 @@ pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Out
     let dt = case.dt();
     let reach = e.state().particles.radius[0] + e.state().particles.radius[1];
     let (mut started, mut steps_in_contact, mut delta_max) = (false, 0u64, 0.0f64);
+    let mut fn_max = 0.0f64;
     for _ in 0..100_000 {
         e.advance(1)?;
         let s = e.snapshot();
@@ -83,6 +86,7 @@ pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Out
             started = true;
             steps_in_contact += 1;
             delta_max = delta_max.max(d);
+            fn_max = fn_max.max(s.contacts[0].force.fn_signed);
         } else if started {
             let p = &s.particles;
             return Ok(Outcome {
@@ -90,6 +94,7 @@ pub fn impact(base: &Case, bodies: [Body; 2], per_tc: f64) -> anyhow::Result<Out
                 w: [p.w[0], p.w[1]],
                 steps_in_contact,
                 delta_max,
+                fn_max,
                 dt,
             });
         }

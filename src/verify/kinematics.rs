@@ -131,7 +131,7 @@ impl LawVisitor for Boxed {
 
 /// The contact law of `case`; an error when the case names no tangential convention.
 pub fn law_of(case: &Case) -> Result<Box<dyn DynLaw>, crate::case::CaseError> {
-    engine::with_law(&case.contact, Boxed)
+    engine::with_law(case, Boxed)
 }
 
 /// The two spheres' starting positions and radii, from the case's `spheres` scene (an error

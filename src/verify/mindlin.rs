@@ -134,6 +134,8 @@ impl Pair {
             mu: self.mu,
             e_star: self.e_star(),
             g_star: self.g_star(),
+            restitution: 1.0,
+            dissipative_constant: 0.0,
         }
     }
 

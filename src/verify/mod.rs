@@ -17,6 +17,9 @@
 //!
 //! Each prescribed-motion row declares the property of a contact law it tests
 //! ([`diagnosis::Property`]): the summary after the table maps the failed rows to them.
+
+//! - [`hertz_impact`]: Hertz head-on impacts against Johnson's closed forms, and the
+//!   restitution of the dampings set from one.
 //!
 //! The table is a list of named [`Entry`]s, selected by name before any of them runs. The
 //! prescribed-motion cases (objectivity, ratchet, histories) drive their contact through a
@@ -27,6 +30,7 @@ pub mod conservation;
 pub mod diagnosis;
 pub mod driver;
 pub mod extremes;
+pub mod hertz_impact;
 pub mod histories;
 pub mod kinematics;
 pub mod mcnamara;
@@ -391,6 +395,11 @@ pub fn entries(dir: &Path) -> Vec<Entry<'_>> {
         mindlin_histories::HISTORIES.map(move |h| mindlin_histories::case_name(c, h))
     });
     list.push(Entry::new(histories, || Ok(mindlin_histories::rows())));
+
+    list.push(Entry::new(
+        ["hertz", "hertz-restitution", "hertz-tsuji"],
+        move || hertz_impact::rows(&load("hertz_impact.toml")?),
+    ));
     list
 }
 

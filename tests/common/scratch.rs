@@ -178,34 +178,24 @@ impl Scratch {
 /// convention"): the objective law with a 1.0001 × kt spring.
 pub const TOY_CONVENTION: &str = r#"    Stiffer = "toy-stiffer", |p| Objective::new(1.0001 * p.kt, p.gammat, p.mu), [objective, twists_spring], "Toy: the objective law with a 1.0001 x kt spring";"#;
 
-/// The recipe's registry line of the toy damping ("A new normal law or damping").
-pub const TOY_DAMPING: &str = r#"    ToyDamping = "toy-damping", mod toy_damping, |p| toy_damping::ToyDamping { kn: p.kn, gamman: 1.0001 * p.gamman }, "Toy: the linear spring with a 1.0001 x gamman dashpot";"#;
+/// The recipe's registry line of the toy damping ("A new normal law or damping"): the linear
+/// spring with a 1.0001 × γn dashpot.
+pub const TOY_DAMPING: &str = r#"    ToyDamping = "toy-damping", mod toy_damping, reads [Kn, Gamman], |p| Damped { spring: Linear { kn: p.kn }, damping: toy_damping::ToyDamping { gamman: 1.0001 * p.gamman } }, "Toy: the linear spring with a 1.0001 x gamman dashpot";"#;
 
-/// The recipe's new file of the toy damping: the linear spring with a 1.0001 × γn dashpot.
-pub const TOY_DAMPING_FILE: &str = r#"//! A toy damping: a linear spring and an absolute dashpot, fn = kn·δ − γn·vn.
+/// The recipe's new file of the toy damping: an absolute dashpot.
+pub const TOY_DAMPING_FILE: &str = r#"//! A toy damping: an absolute dashpot γn (mass/time).
 
-use crate::contact::NormalModel;
+use crate::contact::{Damping, PairKinematics, Spring};
 
-/// Spring kn (force/length) and absolute dashpot γn (mass/time).
+/// Absolute dashpot γn (mass/time).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToyDamping {
-    pub kn: f64,
     pub gamman: f64,
 }
 
-impl NormalModel for ToyDamping {
-    fn force(&self, delta: f64, vn: f64) -> f64 {
-        self.kn * delta - self.gamman * vn
-    }
-
-    fn stored_energy(&self, delta: f64) -> f64 {
-        0.5 * self.kn * delta * delta
-    }
-
-    const SPLITS_DISSIPATION: bool = true;
-
-    fn dissipated(&self, _delta: f64, vn: f64, _fn_signed: f64, dt: f64) -> f64 {
-        self.gamman * vn * vn * dt
+impl Damping for ToyDamping {
+    fn gamma<S: Spring>(&self, _: &S, _: f64, _: &PairKinematics) -> f64 {
+        self.gamman
     }
 }
 "#;
