@@ -216,7 +216,7 @@ fn oblique_rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let cf = closed_form(base, base.particle_mass());
     let (mu, per_tc, r) = (c.mu, 50.0, 0.5 * base.material.diameter);
     let mut rows = Vec::new();
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         let name = conv.name();
         let mut law = base.clone();
         law.contact.tangential = conv.into();
@@ -272,7 +272,7 @@ fn rolling_rows(base: &Case) -> anyhow::Result<Vec<Row>> {
     let (r, g) = (0.5 * base.material.diameter, 10.0);
     let delta = base.particle_mass() * g / base.contact.kn;
     let mut rows = Vec::new();
-    for conv in Tangential::ALL {
+    for conv in Tangential::with_constant_kt() {
         // the arm along which the spin enters the convention's slip
         let arm = match conv.geometry().slip {
             Arms::HalfOverlap => r - 0.5 * delta,
