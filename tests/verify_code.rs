@@ -745,7 +745,9 @@ fn a_law_written_from_the_interface_page_alone_passes_every_row() {
     let scratch = tempfile::tempdir().unwrap();
     let program = External::new(&script("interface_law.py", ""), "newcomer", scratch.path());
     let rows = code_rows(&program, None);
-    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4 + 2 * 2);
+    // objectivity, ratchet, the four tangential histories (load-unload, coulomb limit, contact
+    // loss, dashpots), McNamara
+    assert_eq!(rows.len(), 3 * 3 + 2 * 2 + 9 + 2 + 4 + 2 + 2 * 2);
     assert!(failed(&rows).is_empty(), "{:#?}", failed(&rows));
     assert_eq!(diagnosis::diagnose(&rows).summary(), "");
     // every row declares the property it tests
