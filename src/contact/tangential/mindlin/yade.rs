@@ -5,8 +5,8 @@
 //! (`getIncidentVel` with `preventGranularRatcheting`); Mohr–Coulomb caps the elastic part at
 //! μ|fn| and the viscous part is added after; torques with R − δ/2. verdem caps the total again
 //! after the dashpot (its reference cap). Which mixing of G and ν the shear modulus uses is the
-//! case's G* (`Parameters::g_star`); an older fork averaged G and ν
-//! (`../shared/contact-laws.md`).
+//! case's G* (`Parameters::g_star`); the yade-mpi fork's `Ip2_FrictMat_FrictMat_MindlinPhys`
+//! averages G and ν of the two materials instead.
 
 use super::{Force, NoSlip};
 use crate::contact::tangential::cap::SpringThenTotal;
