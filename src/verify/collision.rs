@@ -190,6 +190,53 @@ const ONSET: f64 = 0.5;
 /// the overlap, plus 1e-12 for the sums over the contact's steps. The engine and
 /// [`crate::stability::discrete_collision`] agree to 1e-10 at v0 = 1e-3 (δmax ≈ 1e-6) and to
 /// 1e-13 at v0 ≥ 1.
+/// The six rows of one head-on impact at speed `v0` (length/time) and step `dt` (time),
+/// measured `got`: restitution (named `e_quantity`), contact time and largest overlap against
+/// the closed form `cf` (case `names[0]`), each held to 1.5 times the error the scheme's
+/// recurrence `ours` makes at this dt (first order in dt: e.g. 3.4e-4 free–free, 8.8e-4
+/// free–wall at tc/50 for e; 6.2e-4 free–wall for δmax, sampled at the ends of steps, O(dt²)
+/// below the peak), the contact time to one step; and against that recurrence (case
+/// `names[1]`) to `tiny`, the contact time to half a step (its count of steps is exact).
+pub fn impact_rows(
+    names: [&str; 2],
+    e_quantity: &str,
+    (cf, ours): (&ClosedForm, &crate::stability::DiscreteCollision),
+    v0: f64,
+    dt: f64,
+    got: &Measured,
+    tiny: f64,
+) -> [Row; 6] {
+    let [name, scheme] = names;
+    let error = |got: f64, exact: f64| (got / exact - 1.0).abs();
+    let steps = ours.steps_in_contact as f64;
+    [
+        row(name, e_quantity, cf.e, got.e, 1.5 * error(ours.e, cf.e)),
+        row(scheme, "restitution e", ours.e, got.e, tiny),
+        row(name, "contact time", cf.tc, got.duration, 1.01 * dt / cf.tc),
+        row(
+            scheme,
+            "contact time",
+            steps * dt,
+            got.duration,
+            0.5 / steps,
+        ),
+        row(
+            name,
+            "max overlap",
+            cf.delta_max_per_speed * v0,
+            got.delta_max,
+            1.5 * error(ours.delta_max_per_speed, cf.delta_max_per_speed),
+        ),
+        row(
+            scheme,
+            "max overlap",
+            ours.delta_max_per_speed * v0,
+            got.delta_max,
+            tiny,
+        ),
+    ]
+}
+
 fn round_off(reach: f64, delta_max: f64) -> f64 {
     1e-12 + 100.0 * f64::EPSILON * reach / delta_max
 }
@@ -244,46 +291,13 @@ pub fn binary_collisions_against(reference: &Case, simulated: &Case) -> anyhow::
             let name = format!("{label} v0={v0} dt=tc/{per_tc}");
             let scheme_name = format!("{label} v0={v0} leapfrog recurrence at tc/{per_tc}");
             let tiny = round_off(reach, ours.delta_max_per_speed * v0);
-            // first order in dt: e.g. 3.4e-4 free–free, 8.8e-4 free–wall at tc/50
-            rows.push(row(
-                &name,
+            rows.extend(impact_rows(
+                [&name, &scheme_name],
                 "restitution e",
-                cf.e,
-                got.e,
-                1.5 * error(ours.e, cf.e),
-            ));
-            rows.push(row(&scheme_name, "restitution e", ours.e, got.e, tiny));
-            // counted in whole steps: known to one step
-            rows.push(row(
-                &name,
-                "contact time",
-                cf.tc,
-                got.duration,
-                1.01 * dt / cf.tc,
-            ));
-            // the recurrence's count of steps is exact: less than half a step
-            let steps = ours.steps_in_contact as f64;
-            rows.push(row(
-                &scheme_name,
-                "contact time",
-                steps * dt,
-                got.duration,
-                0.5 / steps,
-            ));
-            // sampled at the ends of steps, O(dt²) below the peak, and the scheme's O(dt)
-            // error: e.g. 6.2e-4 free–wall at tc/50
-            rows.push(row(
-                &name,
-                "max overlap",
-                cf.delta_max_per_speed * v0,
-                got.delta_max,
-                1.5 * error(ours.delta_max_per_speed, cf.delta_max_per_speed),
-            ));
-            rows.push(row(
-                &scheme_name,
-                "max overlap",
-                ours.delta_max_per_speed * v0,
-                got.delta_max,
+                (&cf, &ours),
+                v0,
+                dt,
+                &got,
                 tiny,
             ));
             let mut clipped = simulated.clone();

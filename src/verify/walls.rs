@@ -12,6 +12,7 @@
 //!   contact's spring stays at round-off (a wrong sign of ω × arm at a wall, Lethe #889, makes
 //!   it slide at twice the speed).
 
+use super::collision::{impact_rows, Measured};
 use super::{closed_form, row, row_abs, Row};
 use crate::analysis::stats::slope;
 use crate::case::{Case, Scene, WallSpec};
@@ -122,7 +123,6 @@ fn head_on_rows(case: &Case) -> anyhow::Result<Vec<Row>> {
     let cf = closed_form(case, m);
     let ours = discrete_collision(m, spring, dt, 1.0 - ONSET, false)
         .ok_or_else(|| anyhow::anyhow!("the scheme is unstable at dt = {dt}"))?;
-    let error = |got: f64, exact: f64| (got / exact - 1.0).abs();
     let mut rows = Vec::new();
     for v0 in [1e-3, 1.0, 10.0] {
         let got = head_on(case, v0, per_tc, ONSET)?;
@@ -132,41 +132,18 @@ fn head_on_rows(case: &Case) -> anyhow::Result<Vec<Row>> {
         let scheme = format!("plane v0={v0} leapfrog recurrence at tc/{per_tc}");
         // the overlap is a difference of positions of size R: ~ε·R a step, over the overlap
         let tiny = 1e-12 + 100.0 * f64::EPSILON * case.material.diameter / got.delta_max;
-        rows.push(row(
-            &name,
-            "restitution e (m* = m)",
-            cf.e,
+        let measured = Measured {
             e,
-            1.5 * error(ours.e, cf.e),
-        ));
-        rows.push(row(&scheme, "restitution e", ours.e, e, tiny));
-        rows.push(row(
-            &name,
-            "contact time",
-            cf.tc,
             duration,
-            1.01 * dt / cf.tc,
-        ));
-        let steps = ours.steps_in_contact as f64;
-        rows.push(row(
-            &scheme,
-            "contact time",
-            steps * dt,
-            duration,
-            0.5 / steps,
-        ));
-        rows.push(row(
-            &name,
-            "max overlap",
-            cf.delta_max_per_speed * v0,
-            got.delta_max,
-            1.5 * error(ours.delta_max_per_speed, cf.delta_max_per_speed),
-        ));
-        rows.push(row(
-            &scheme,
-            "max overlap",
-            ours.delta_max_per_speed * v0,
-            got.delta_max,
+            delta_max: got.delta_max,
+        };
+        rows.extend(impact_rows(
+            [&name, &scheme],
+            "restitution e (m* = m)",
+            (&cf, &ours),
+            v0,
+            dt,
+            &measured,
             tiny,
         ));
     }
